@@ -1,0 +1,156 @@
+#include "common.h"
+
+#include <sys/resource.h>
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <sstream>
+
+namespace voxpress::cli {
+
+void Global::apply() const {
+  static std::unique_ptr<tbb::global_control> control;
+  if (threads > 0)
+    control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
+}
+
+ProgressBar::ProgressBar(bool enabled) : enabled_(enabled && ::isatty(2)) {}
+
+void ProgressBar::begin(std::string_view stage, uint64_t total) {
+  std::lock_guard lock(m_);
+  stage_ = stage;
+  total_ = std::max<uint64_t>(total, 1);
+  last_percent_ = -1;
+}
+
+bool ProgressBar::update(uint64_t done) {
+  const int percent = int(100 * std::min(done, total_) / total_);
+  if (percent == last_percent_) return true;
+  std::lock_guard lock(m_);
+  if (percent > last_percent_) {
+    last_percent_ = percent;
+    draw(done, false);
+  }
+  return true;
+}
+
+void ProgressBar::end() {
+  std::lock_guard lock(m_);
+  draw(total_, true);
+}
+
+void ProgressBar::draw(uint64_t done, bool final) {
+  constexpr int kWidth = 30;
+  const int filled = int(kWidth * std::min(done, total_) / total_);
+  std::fprintf(stderr, "\r%-14s [%.*s%*s] %3d%%", stage_.c_str(), filled, "##############################",
+               kWidth - filled, "", int(100 * std::min(done, total_) / total_));
+  if (final) std::fputs("\r\033[K", stderr);
+  std::fflush(stderr);
+}
+
+void InputOptions::bind(CLI::App& cmd) {
+  cmd.add_option("--label", label, "Inside = samples with this label (a number), or 'all-nonzero'");
+  cmd.add_option("--threshold", threshold, "Inside = samples >= T (grey-level volumes)");
+  cmd.add_option("--segment", segment, "Inside = this segment of a 3D Slicer .seg.nrrd (name or ID)");
+  auto* g = cmd.add_option_group("raw", "Headerless .raw/.bin input");
+  g->add_option("--raw-dims", raw_dims, "X,Y,Z sample counts (makes the input raw)");
+  g->add_option("--raw-type", raw_type, "uint8 int8 uint16 int16 uint32 int32 uint64 int64 float32 float64")
+      ->capture_default_str();
+  g->add_option("--raw-spacing", raw_spacing, "SX,SY,SZ cell size (default 1,1,1)");
+  g->add_option("--raw-origin", raw_origin, "OX,OY,OZ position of the first sample (default 0,0,0)");
+  g->add_flag("--raw-big-endian", raw_big_endian, "Samples are big-endian");
+  g->add_option("--raw-header-bytes", raw_header_bytes, "Bytes to skip before the samples");
+}
+
+ReadOptions InputOptions::read_options(const Global& g) const {
+  ReadOptions r;
+  r.max_bytes = g.memory_limit();
+  if (!raw_dims.empty()) {
+    RawLayout layout;
+    const Vec3 d = parse_vec3(raw_dims, "--raw-dims");
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] < 1 || d[a] != std::floor(d[a])) throw UsageError("--raw-dims needs three positive integers");
+      layout.dims[size_t(a)] = int64_t(d[a]);
+    }
+    layout.type = parse_scalar_type(raw_type);
+    if (!raw_spacing.empty()) layout.spacing = parse_vec3(raw_spacing, "--raw-spacing");
+    if (!raw_origin.empty()) layout.origin = parse_vec3(raw_origin, "--raw-origin");
+    layout.big_endian = raw_big_endian;
+    layout.header_bytes = raw_header_bytes;
+    r.raw = layout;
+  }
+  return r;
+}
+
+Selection InputOptions::selection() const {
+  const int given = int(!label.empty()) + int(threshold.has_value()) + int(!segment.empty());
+  if (given > 1) throw UsageError("choose one of --label, --threshold and --segment");
+  Selection s;
+  if (!label.empty()) s = parse_label_selection(label);
+  if (threshold) {
+    s.kind = Selection::Kind::threshold;
+    s.value = *threshold;
+  }
+  if (!segment.empty()) {
+    s.kind = Selection::Kind::segment;
+    s.segment = segment;
+  }
+  return s;
+}
+
+ScalarVolume load_volume(const std::string& path, const InputOptions& in, const Global& g) {
+  return read_volume(path, in.read_options(g));
+}
+
+BinaryVolume load_binary(const std::string& path, const InputOptions& in, const Global& g) {
+  const Selection sel = in.selection();  // usage errors before any I/O
+  BinaryVolume b = binarize(load_volume(path, in, g), sel);
+  require_mixed(b);
+  return b;
+}
+
+nlohmann::json lattice_json(const Lattice& l) {
+  nlohmann::json j;
+  j["dims"] = {l.dims[0], l.dims[1], l.dims[2]};
+  j["spacing"] = {l.spacing.x(), l.spacing.y(), l.spacing.z()};
+  j["origin"] = {l.origin.x(), l.origin.y(), l.origin.z()};
+  nlohmann::json d = nlohmann::json::array();
+  for (int a = 0; a < 3; ++a) d.push_back({l.direction(0, a), l.direction(1, a), l.direction(2, a)});
+  j["direction_columns"] = d;
+  j["space"] = space_name(l.space);
+  return j;
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) {
+  const std::string text = j.dump(2) + "\n";
+  write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+uint64_t peak_rss_bytes() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return uint64_t(ru.ru_maxrss) * 1024;
+}
+
+Vec3 parse_vec3(const std::string& text, const std::string& option) {
+  std::stringstream in(text);
+  std::string part;
+  Vec3 v;
+  int n = 0;
+  while (std::getline(in, part, ',')) {
+    if (n >= 3) throw UsageError(option + " expects three comma-separated numbers, got '" + text + "'");
+    try {
+      size_t used = 0;
+      v[n] = std::stod(part, &used);
+      if (used != part.size() || !std::isfinite(v[n])) throw std::invalid_argument("junk");
+    } catch (const std::exception&) {
+      throw UsageError(option + " expects three comma-separated numbers, got '" + text + "'");
+    }
+    ++n;
+  }
+  if (n != 3) throw UsageError(option + " expects three comma-separated numbers, got '" + text + "'");
+  return v;
+}
+
+}  // namespace voxpress::cli

@@ -1,0 +1,89 @@
+// Shared pieces of the voxpress subcommands: global options, the progress
+// bar, input selection (labels, thresholds, raw layouts) and --stats-json.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "voxpress/voxpress.h"
+
+namespace voxpress::cli {
+
+/// Options every subcommand shares (bound on the main app).
+struct Global {
+  int threads = 0;             ///< 0 = all cores
+  bool quiet = false;
+  std::string max_memory;      ///< e.g. "8G"; empty = default_memory_limit()
+  uint64_t memory_limit() const { return max_memory.empty() ? default_memory_limit() : parse_byte_size(max_memory); }
+  /// Applies --threads (once, before a subcommand runs).
+  void apply() const;
+};
+
+/// A progress bar on stderr, drawn only when stderr is a terminal and
+/// --quiet is off; thread-safe and throttled.
+class ProgressBar : public Progress {
+ public:
+  explicit ProgressBar(bool enabled);
+  void begin(std::string_view stage, uint64_t total) override;
+  bool update(uint64_t done) override;
+  void end() override;
+  Progress* get() { return enabled_ ? this : nullptr; }
+
+ private:
+  void draw(uint64_t done, bool final);
+  bool enabled_;
+  std::mutex m_;
+  std::string stage_;
+  uint64_t total_ = 1;
+  int last_percent_ = -1;
+};
+
+/// How a volume file becomes a binary volume.
+struct InputOptions {
+  std::string label;               ///< "N" or "all-nonzero"
+  std::optional<double> threshold;
+  std::string segment;
+  std::string raw_dims, raw_type = "uint8", raw_spacing, raw_origin;
+  bool raw_big_endian = false;
+  uint64_t raw_header_bytes = 0;
+
+  /// Adds --label, --threshold, --segment and the --raw-* options to a command.
+  void bind(CLI::App& cmd);
+  ReadOptions read_options(const Global& g) const;
+  Selection selection() const;
+};
+
+ScalarVolume load_volume(const std::string& path, const InputOptions& in, const Global& g);
+/// Reads, binarises and checks that the volume is neither empty nor full.
+BinaryVolume load_binary(const std::string& path, const InputOptions& in, const Global& g);
+
+/// Wall-clock stopwatch for --stats-json.
+class Stopwatch {
+ public:
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+
+ private:
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+};
+
+nlohmann::json lattice_json(const Lattice& l);
+/// Writes a JSON document atomically (pretty-printed).
+void write_json(const std::string& path, const nlohmann::json& j);
+/// Peak resident memory of this process so far, in bytes.
+uint64_t peak_rss_bytes();
+
+/// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).
+Vec3 parse_vec3(const std::string& text, const std::string& option);
+
+// Subcommand registration (one file each).
+void register_info(CLI::App& app, Global& g);
+void register_extract(CLI::App& app, Global& g);
+void register_generate(CLI::App& app, Global& g);
+void register_check(CLI::App& app, Global& g);
+
+}  // namespace voxpress::cli

@@ -1,0 +1,45 @@
+// voxpress — command-line front end. Each subcommand lives in its own file
+// and only calls library stages; this file owns the one place where
+// exceptions become a message and an exit code:
+//   0 success   1 bad input (file missing, malformed, limit hit, check failed)
+//   2 bad usage (options)   3 internal error (a bug: please report it)
+#include <cstdio>
+#include <memory>
+
+#include "common.h"
+
+int main(int argc, char** argv) {
+  using namespace voxpress;
+  CLI::App app{"voxpress — smooth, accurate solids from binary voxel volumes", "voxpress"};
+  app.set_version_flag("--version", std::string("voxpress ") + kVersion);
+  app.require_subcommand(1);
+  cli::Global g;
+  app.add_option("--threads", g.threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_flag("-q,--quiet", g.quiet, "No progress bar");
+  app.add_option("--max-memory", g.max_memory, "Refuse inputs needing more memory than this (e.g. 8G; default: "
+                                               "3/4 of RAM or $VOXPRESS_MAX_MEMORY)");
+  app.fallthrough();
+  cli::register_info(app, g);
+  cli::register_extract(app, g);
+  cli::register_generate(app, g);
+  cli::register_check(app, g);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "voxpress: error: %s (see voxpress --help)\n", e.what());
+    return 2;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "voxpress: error: %s\n", e.what());
+    return 2;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "voxpress: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "voxpress: internal error: %s\n", e.what());
+    return 3;
+  }
+  return 0;
+}

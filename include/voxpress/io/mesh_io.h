@@ -1,0 +1,40 @@
+// voxpress/io/mesh_io.h — reading and writing triangle meshes.
+//
+// Writers (format from the extension): .ply (binary little-endian by
+// default, or ASCII; positions as double; normals, RGBA colours and every
+// named vertex/face attribute as properties), .obj, .stl (binary; float32
+// per the format), .off, .glb / .gltf (glTF 2.0; float32 positions, uint32
+// indices, optional normals and colours). Every write is atomic.
+// Readers: .ply (ASCII and binary of either endianness, any extra properties
+// kept as attributes, polygons fanned into triangles), .obj (tinyobjloader,
+// double precision), .stl (binary — even when the header starts with
+// "solid" — or ASCII; identical vertices welded), .off (OFF/COFF/NOFF).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "voxpress/core/mesh.h"
+
+namespace voxpress {
+
+enum class MeshFormat { ply, obj, stl, off, gltf, glb };
+
+/// Format from the extension; throws InputError for an unknown one.
+MeshFormat mesh_format_from_path(const std::string& path);
+
+struct MeshWriteOptions {
+  bool ascii = false;  ///< PLY only: ASCII instead of binary little-endian
+};
+
+void write_mesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options = {});
+
+struct MeshReadOptions {
+  uint64_t max_bytes = 0;  ///< memory cap; 0 = default_memory_limit()
+};
+
+/// Reads a PLY, OBJ, STL or OFF mesh. Throws InputError for missing files,
+/// malformed or truncated data and out-of-range indices.
+Mesh read_mesh(const std::string& path, const MeshReadOptions& options = {});
+
+}  // namespace voxpress

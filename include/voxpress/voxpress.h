@@ -1,0 +1,20 @@
+// voxpress/voxpress.h — everything, for convenience.
+#pragma once
+
+#include "voxpress/core/error.h"
+#include "voxpress/core/lattice.h"
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/progress.h"
+#include "voxpress/core/types.h"
+#include "voxpress/core/volume.h"
+#include "voxpress/eval/checks.h"
+#include "voxpress/eval/shapes.h"
+#include "voxpress/extract/cube_cases.h"
+#include "voxpress/extract/sticks.h"
+#include "voxpress/io/atomic_file.h"
+#include "voxpress/io/mesh_io.h"
+#include "voxpress/io/volume_io.h"
+
+namespace voxpress {
+inline constexpr const char* kVersion = "0.1.0";
+}

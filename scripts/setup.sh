@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# scripts/setup.sh [--tests] — installs what voxpress needs on Debian 12 (only
+# the packages that are missing) and builds it in Release under build/.
+# --tests also installs the Node packages the test suite uses (npm ci).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+with_tests=0
+[ "${1:-}" = "--tests" ] && with_tests=1
+
+packages=(build-essential cmake ninja-build pkg-config
+          libeigen3-dev libtbb-dev zlib1g-dev libtiff-dev libnifti2-dev
+          libtinygltf-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
+          libgtest-dev libgmock-dev libbenchmark-dev)
+[ $with_tests = 1 ] && packages+=(nodejs)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+# npm ships inside nodesource's nodejs; Debian's nodejs needs the npm package.
+if [ $with_tests = 1 ] && ! command -v npm >/dev/null 2>&1; then missing+=(npm); fi
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""; [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "setup: installing ${missing[*]}" >&2
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
+
+if [ $with_tests = 1 ]; then
+  (cd "$root/tests/js" && npm ci --no-audit --no-fund --loglevel=error >&2) ||
+    echo "setup: npm ci failed; the glTF validator test will be skipped" >&2
+fi
+
+cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release ${VOXPRESS_CMAKE_ARGS:-} >/dev/null
+cmake --build "$root/build" -j "$(nproc)" >&2

@@ -1,0 +1,40 @@
+#include "voxpress/core/lattice.h"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "voxpress/core/error.h"
+
+namespace voxpress {
+
+const char* space_name(Space s) {
+  switch (s) {
+    case Space::LPS: return "LPS";
+    case Space::RAS: return "RAS";
+    default: return "unknown";
+  }
+}
+
+uint64_t Lattice::size() const { return uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]); }
+
+Mat3 Lattice::index_to_physical_matrix() const { return direction * spacing.asDiagonal(); }
+
+Vec3 Lattice::to_physical(const Vec3& ijk) const { return origin + index_to_physical_matrix() * ijk; }
+
+Vec3 Lattice::to_index(const Vec3& p) const { return index_to_physical_matrix().inverse() * (p - origin); }
+
+bool Lattice::flips_orientation() const { return index_to_physical_matrix().determinant() < 0; }
+
+void Lattice::validate() const {
+  for (int a = 0; a < 3; ++a) {
+    if (dims[a] < 1)
+      throw UsageError("invalid dimension along axis " + std::to_string(a) + ": " + std::to_string(dims[a]));
+    if (!std::isfinite(spacing[a]) || spacing[a] <= 0)
+      throw UsageError("lattice spacing along axis " + std::to_string(a) + " must be finite and > 0");
+    if (!std::isfinite(origin[a])) throw UsageError("lattice origin is not finite");
+  }
+  if (!direction.allFinite() || std::abs(index_to_physical_matrix().determinant()) < 1e-300)
+    throw UsageError("lattice direction matrix is singular or not finite");
+}
+
+}  // namespace voxpress

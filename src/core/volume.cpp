@@ -1,0 +1,267 @@
+#include "voxpress/core/volume.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <unordered_map>
+
+#include "voxpress/core/error.h"
+
+namespace voxpress {
+
+size_t scalar_size(ScalarType t) {
+  switch (t) {
+    case ScalarType::u8:
+    case ScalarType::i8: return 1;
+    case ScalarType::u16:
+    case ScalarType::i16: return 2;
+    case ScalarType::u32:
+    case ScalarType::i32:
+    case ScalarType::f32: return 4;
+    default: return 8;
+  }
+}
+
+const char* scalar_name(ScalarType t) {
+  switch (t) {
+    case ScalarType::u8: return "uint8";
+    case ScalarType::i8: return "int8";
+    case ScalarType::u16: return "uint16";
+    case ScalarType::i16: return "int16";
+    case ScalarType::u32: return "uint32";
+    case ScalarType::i32: return "int32";
+    case ScalarType::u64: return "uint64";
+    case ScalarType::i64: return "int64";
+    case ScalarType::f32: return "float32";
+    default: return "float64";
+  }
+}
+
+bool scalar_is_float(ScalarType t) { return t == ScalarType::f32 || t == ScalarType::f64; }
+
+double ScalarVolume::value(uint64_t n) const {
+  return visit([n](auto values) { return double(values[n]); });
+}
+
+uint64_t BinaryVolume::count_inside() const {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, inside.size(), 1 << 16), uint64_t{0},
+      [&](const tbb::blocked_range<size_t>& r, uint64_t acc) {
+        for (size_t s = r.begin(); s < r.end(); ++s) acc += inside[s];
+        return acc;
+      },
+      std::plus<>());
+}
+
+Selection parse_label_selection(const std::string& text) {
+  Selection s;
+  if (text == "all-nonzero" || text == "nonzero") {
+    s.kind = Selection::Kind::nonzero;
+    return s;
+  }
+  double v = 0;
+  auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v))
+    throw UsageError("--label expects a number or 'all-nonzero', got '" + text + "'");
+  s.kind = Selection::Kind::label;
+  s.value = v;
+  return s;
+}
+
+namespace {
+
+std::string format_value(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+// First non-zero value and whether another, different non-zero value exists.
+struct NonzeroSummary {
+  bool any = false;
+  double first = 0;
+  bool several = false;
+  bool fractional = false;  // some value is not an integer
+  double lo = 0, hi = 0;
+};
+
+NonzeroSummary summarize(const ScalarVolume& v, int64_t component, int64_t stride) {
+  return v.visit([&](auto values) {
+    NonzeroSummary s;
+    bool init = false;
+    for (uint64_t n = uint64_t(component); n < values.size(); n += uint64_t(stride)) {
+      const double x = double(values[n]);
+      if (!init) {
+        s.lo = s.hi = x;
+        init = true;
+      }
+      s.lo = std::min(s.lo, x);
+      s.hi = std::max(s.hi, x);
+      if (x != std::floor(x)) s.fractional = true;
+      if (x == 0) continue;
+      if (!s.any) {
+        s.any = true;
+        s.first = x;
+      } else if (x != s.first) {
+        s.several = true;
+      }
+    }
+    return s;
+  });
+}
+
+template <class Pred>
+BinaryVolume select(const ScalarVolume& v, int64_t component, Pred pred) {
+  BinaryVolume b;
+  b.lattice = v.lattice;
+  b.source = v.source;
+  const uint64_t n = v.lattice.size();
+  b.inside.resize(n);
+  const int64_t stride = v.components;
+  v.visit([&](auto values) {
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 1 << 16), [&](const tbb::blocked_range<uint64_t>& r) {
+      for (uint64_t s = r.begin(); s < r.end(); ++s)
+        b.inside[s] = pred(double(values[s * uint64_t(stride) + uint64_t(component)])) ? 1 : 0;
+    });
+  });
+  return b;
+}
+
+template <class Pred>
+BinaryVolume select_any_component(const ScalarVolume& v, Pred pred) {
+  BinaryVolume b = select(v, 0, pred);
+  for (int64_t c = 1; c < v.components; ++c) {
+    BinaryVolume other = select(v, c, pred);
+    for (size_t s = 0; s < b.inside.size(); ++s) b.inside[s] |= other.inside[s];
+  }
+  return b;
+}
+
+}  // namespace
+
+BinaryVolume binarize(const ScalarVolume& v, const Selection& sel) {
+  using K = Selection::Kind;
+  switch (sel.kind) {
+    case K::label: {
+      const double label = sel.value;
+      BinaryVolume b = select_any_component(v, [label](double x) { return x == label; });
+      if (b.count_inside() == 0)
+        throw InputError(v.source, "no sample has label " + format_value(label) + " (see `voxpress info`)");
+      return b;
+    }
+    case K::nonzero: return select_any_component(v, [](double x) { return x != 0; });
+    case K::threshold: {
+      const double t = sel.value;
+      return select_any_component(v, [t](double x) { return x >= t; });
+    }
+    case K::segment: {
+      for (const Segment& s : v.segments) {
+        if (s.name == sel.segment || s.id == sel.segment) {
+          if (s.layer < 0 || s.layer >= v.components)
+            throw InputError(v.source, "segment '" + sel.segment + "' names layer " + std::to_string(s.layer) +
+                                           " but the file has " + std::to_string(v.components));
+          const double label = s.label;
+          return select(v, s.layer, [label](double x) { return x == label; });
+        }
+      }
+      std::string names;
+      for (const Segment& s : v.segments) names += (names.empty() ? "" : ", ") + s.name;
+      throw InputError(v.source, "no segment named '" + sel.segment + "'" +
+                                     (names.empty() ? " (the file has no segments)" : " (segments: " + names + ")"));
+    }
+    case K::automatic: break;
+  }
+  // Automatic: a mask with a single non-zero value is unambiguous.
+  if (v.segments.size() == 1) {
+    Selection s;
+    s.kind = K::segment;
+    s.segment = v.segments[0].id.empty() ? v.segments[0].name : v.segments[0].id;
+    return binarize(v, s);
+  }
+  if (v.segments.size() > 1) {
+    std::string names;
+    for (const Segment& s : v.segments) names += (names.empty() ? "" : ", ") + s.name;
+    throw InputError(v.source, "segmentation with " + std::to_string(v.segments.size()) + " segments (" + names +
+                                   "); choose one with --segment NAME or --label N");
+  }
+  NonzeroSummary total;
+  for (int64_t c = 0; c < v.components; ++c) {
+    NonzeroSummary s = summarize(v, c, v.components);
+    if (c == 0) {
+      total = s;
+    } else {
+      total.several |= s.several || (s.any && total.any && s.first != total.first);
+      total.fractional |= s.fractional;
+      if (!total.any) total.first = s.first;
+      total.any |= s.any;
+    }
+  }
+  if (total.fractional)
+    throw InputError(v.source, std::string("grey-level volume (") + scalar_name(v.type) + ", values " +
+                                   format_value(total.lo) + " .. " + format_value(total.hi) +
+                                   "); choose an iso-level with --threshold T");
+  if (total.several) {
+    auto hist = value_histogram(v, 64);
+    std::string labels;
+    size_t count = 0;
+    if (hist) {
+      for (auto& [value, n] : *hist)
+        if (value != 0) {
+          if (count < 8) labels += (labels.empty() ? "" : ", ") + format_value(value);
+          ++count;
+        }
+      if (count > 8) labels += ", ...";
+    }
+    throw InputError(v.source, hist ? "label map with " + std::to_string(count) + " labels (" + labels +
+                                          "); choose one with --label N or --label all-nonzero"
+                                    : std::string("volume with many distinct values; choose --label N, "
+                                                  "--label all-nonzero or --threshold T"));
+  }
+  return select_any_component(v, [](double x) { return x != 0; });
+}
+
+std::optional<std::vector<std::pair<double, uint64_t>>> value_histogram(const ScalarVolume& v, size_t max_distinct) {
+  using Result = std::optional<std::vector<std::pair<double, uint64_t>>>;
+  return v.visit([&](auto values) -> Result {
+    using T = typename decltype(values)::value_type;
+    std::vector<std::pair<double, uint64_t>> out;
+    if constexpr (sizeof(T) <= 2 && std::is_integral_v<T>) {
+      // Dense counting for 8- and 16-bit types.
+      constexpr int64_t lo = std::numeric_limits<T>::min();
+      constexpr size_t range = size_t(1) << (8 * sizeof(T));
+      std::vector<uint64_t> counts(range, 0);
+      for (T x : values) ++counts[size_t(int64_t(x) - lo)];
+      for (size_t i = 0; i < range; ++i)
+        if (counts[i]) out.emplace_back(double(int64_t(i) + lo), counts[i]);
+      if (out.size() > max_distinct) return std::nullopt;
+    } else {
+      std::unordered_map<T, uint64_t> counts;
+      for (T x : values) {
+        auto [it, fresh] = counts.try_emplace(x, 0);
+        ++it->second;
+        if (fresh && counts.size() > max_distinct) return std::nullopt;
+      }
+      for (auto& [x, n] : counts) out.emplace_back(double(x), n);
+      std::sort(out.begin(), out.end());
+    }
+    return out;
+  });
+}
+
+ScalarVolume to_scalar(const BinaryVolume& b) {
+  ScalarVolume v;
+  v.lattice = b.lattice;
+  v.type = ScalarType::u8;
+  v.bytes.resize(b.inside.size());
+  std::memcpy(v.bytes.data(), b.inside.data(), b.inside.size());
+  v.source = b.source;
+  return v;
+}
+
+}  // namespace voxpress

@@ -1,0 +1,242 @@
+#include "io_util.h"
+
+#include "voxpress/io/atomic_file.h"
+
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace voxpress::detail {
+
+namespace fs = std::filesystem;
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string extension_of(const std::string& path) {
+  const std::string name = lower(fs::path(path).filename().string());
+  for (const char* compound : {".nii.gz", ".seg.nrrd", ".seg.nhdr"})
+    if (name.size() > std::strlen(compound) && name.ends_with(compound)) return compound;
+  const auto dot = name.rfind('.');
+  return dot == std::string::npos || dot == 0 ? std::string() : name.substr(dot);
+}
+
+std::string trim(std::string_view s) {
+  size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return std::string(s.substr(a, b - a));
+}
+
+std::vector<std::string> split_ws(std::string_view s) {
+  std::vector<std::string> out;
+  size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+    size_t j = i;
+    while (j < s.size() && !std::isspace(static_cast<unsigned char>(s[j]))) ++j;
+    if (j > i) out.emplace_back(s.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+uint64_t file_size(const std::string& path) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) throw InputError(path, "no such file");
+  if (fs::is_directory(status)) throw InputError(path, "is a directory, not a file");
+  const auto size = fs::file_size(path, ec);
+  if (ec) throw InputError(path, "cannot read: " + ec.message());
+  return size;
+}
+
+void read_range_into(const std::string& path, uint64_t offset, std::byte* out, uint64_t size) {
+  const uint64_t total = file_size(path);
+  if (offset > total || size > total - offset)
+    throw InputError(path, "truncated: the data needs " + std::to_string(size) + " bytes at offset " +
+                               std::to_string(offset) + " but the file has " + std::to_string(total) + " bytes");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  in.seekg(std::streamoff(offset));
+  in.read(reinterpret_cast<char*>(out), std::streamsize(size));
+  if (uint64_t(in.gcount()) != size) throw InputError(path, "read error");
+}
+
+std::vector<std::byte> read_range(const std::string& path, uint64_t offset, uint64_t size) {
+  std::vector<std::byte> buf(size);
+  read_range_into(path, offset, buf.data(), size);
+  return buf;
+}
+
+void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected) {
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(path, "zlib initialisation failed");
+  struct Guard {
+    z_stream* z;
+    ~Guard() { inflateEnd(z); }
+  } guard{&zs};
+  uint64_t produced = 0;
+  size_t consumed = 0;
+  const uInt kChunk = 1u << 30;
+  for (;;) {
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(in + consumed));
+    zs.avail_in = uInt(std::min<size_t>(in_size - consumed, kChunk));
+    unsigned char probe;
+    const bool full = produced == expected;
+    zs.next_out = full ? &probe : reinterpret_cast<Bytef*>(out + produced);
+    zs.avail_out = full ? 1u : uInt(std::min<uint64_t>(expected - produced, kChunk));
+    const uInt before_in = zs.avail_in, before_out = zs.avail_out;
+    const int rc = inflate(&zs, Z_NO_FLUSH);
+    consumed += before_in - zs.avail_in;
+    const uInt wrote = before_out - zs.avail_out;
+    if (full && wrote > 0)
+      throw InputError(path, "the compressed payload holds more than the " + std::to_string(expected) +
+                                 " bytes the header declares (dimensions or type do not match the data)");
+    produced += full ? 0 : wrote;
+    if (rc == Z_STREAM_END) {
+      // Another gzip member may follow (concatenated gzip).
+      size_t skip = consumed;
+      while (skip < in_size && in[skip] == std::byte{0}) ++skip;
+      if (skip + 2 <= in_size && in[skip] == std::byte{0x1f} && in[skip + 1] == std::byte{0x8b}) {
+        consumed = skip;
+        inflateReset(&zs);
+        continue;
+      }
+      break;
+    }
+    if (rc == Z_BUF_ERROR && consumed == in_size) break;  // input exhausted
+    if (rc != Z_OK && rc != Z_BUF_ERROR)
+      throw InputError(path, std::string("corrupt compressed payload (zlib: ") + (zs.msg ? zs.msg : "error") + ")");
+    if (consumed == in_size && zs.avail_out != 0 && wrote == 0) break;
+  }
+  if (produced < expected)
+    throw InputError(path, "truncated: the compressed payload holds " + std::to_string(produced) +
+                               " bytes but the header declares " + std::to_string(expected));
+}
+
+std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzip_wrapper, int level) {
+  z_stream zs{};
+  if (deflateInit2(&zs, level, Z_DEFLATED, gzip_wrapper ? 16 + 15 : 15, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+    throw Error("zlib initialisation failed");
+  std::vector<std::byte> out;
+  size_t consumed = 0;
+  const size_t kChunk = size_t(1) << 30;
+  int rc = Z_OK;
+  do {
+    const size_t take = std::min(size - consumed, kChunk);
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(in + consumed));
+    zs.avail_in = uInt(take);
+    consumed += take;
+    const int flush = consumed == size ? Z_FINISH : Z_NO_FLUSH;
+    do {
+      const size_t pos = out.size();
+      out.resize(pos + (1u << 20));
+      zs.next_out = reinterpret_cast<Bytef*>(out.data() + pos);
+      zs.avail_out = 1u << 20;
+      rc = deflate(&zs, flush);
+      out.resize(pos + (1u << 20) - zs.avail_out);
+    } while (zs.avail_out == 0);
+  } while (consumed < size || rc != Z_STREAM_END);
+  deflateEnd(&zs);
+  return out;
+}
+
+void swap_bytes(std::byte* data, uint64_t count, size_t width) {
+  if (width <= 1) return;
+  for (uint64_t i = 0; i < count; ++i) std::reverse(data + i * width, data + (i + 1) * width);
+}
+
+void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what) {
+  if (cap && bytes > cap)
+    throw LimitError(path, what + " needs " + std::to_string(bytes >> 20) + " MiB, above the memory limit of " +
+                               std::to_string(cap >> 20) + " MiB (raise it with --max-memory)");
+}
+
+uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
+                       size_t value_size) {
+  uint64_t n = 1;
+  constexpr uint64_t kMax = uint64_t(1) << 62;
+  for (int64_t d : {dims[0], dims[1], dims[2], components}) {
+    if (d < 1) throw InputError(path, "invalid dimension " + std::to_string(d));
+    if (uint64_t(d) > kMax / n) throw LimitError(path, "absurd dimensions: the sample count overflows");
+    n *= uint64_t(d);
+  }
+  if (n > kMax / value_size) throw LimitError(path, "absurd dimensions: the data size overflows");
+  return n;
+}
+
+double parse_double(const std::string& path, const std::string& text, const std::string& what) {
+  const std::string t = trim(text);
+  double v = 0;
+  auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || ptr != t.data() + t.size()) {
+    // Accept the spellings from_chars rejects ("+1", "nan").
+    const std::string l = lower(t);
+    if (l == "nan" || l == "+nan" || l == "-nan") return std::numeric_limits<double>::quiet_NaN();
+    if (!t.empty() && t[0] == '+') return parse_double(path, t.substr(1), what);
+    throw InputError(path, what + ": '" + t + "' is not a number");
+  }
+  return v;
+}
+
+int64_t parse_int(const std::string& path, const std::string& text, const std::string& what) {
+  const std::string t = trim(text);
+  int64_t v = 0;
+  const char* b = t.data();
+  if (!t.empty() && t[0] == '+') ++b;
+  auto [ptr, ec] = std::from_chars(b, t.data() + t.size(), v);
+  if (ec != std::errc() || ptr != t.data() + t.size()) throw InputError(path, what + ": '" + t + "' is not an integer");
+  return v;
+}
+
+void write_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path target(path);
+  fs::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(path, "the output folder does not exist");
+  const std::string ext = extension_of(path);
+  // Built with append(): GCC 12 warns falsely (-Wrestrict) on chained operator+.
+  std::string name(".");
+  name.append(target.filename().string()).append(".tmp").append(std::to_string(::getpid()));
+  name.append("-").append(std::to_string(counter++)).append(ext);
+  const fs::path tmp = dir / name;
+  try {
+    write(tmp.string());
+    fs::rename(tmp, target, ec);
+    if (ec) throw InputError(path, "cannot write: " + ec.message());
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
+}
+
+void write_stream_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  write_atomically(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(path, std::string("cannot write: ") + std::strerror(errno));
+    write(out);
+    out.flush();
+    if (!out) throw InputError(path, "write failed (disk full?)");
+  });
+}
+
+}  // namespace voxpress::detail
+
+namespace voxpress {
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  detail::write_stream_atomically(path, write);
+}
+}  // namespace voxpress

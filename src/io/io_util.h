@@ -1,0 +1,61 @@
+// Shared helpers of the readers and writers (private).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "voxpress/core/error.h"
+#include "voxpress/core/volume.h"
+
+namespace voxpress::detail {
+
+/// Lower-case extension including compound ones: ".nii.gz", ".seg.nrrd", ".nrrd".
+std::string extension_of(const std::string& path);
+std::string lower(std::string s);
+std::string trim(std::string_view s);
+std::vector<std::string> split_ws(std::string_view s);
+
+/// Size of a regular file; throws InputError (missing, directory, unreadable).
+uint64_t file_size(const std::string& path);
+/// Reads [offset, offset + size) of a file; throws InputError naming `label`
+/// when the file is shorter.
+std::vector<std::byte> read_range(const std::string& path, uint64_t offset, uint64_t size);
+void read_range_into(const std::string& path, uint64_t offset, std::byte* out, uint64_t size);
+
+/// Inflates a gzip or zlib stream (auto-detected, multi-member gzip allowed)
+/// into exactly `expected` bytes without ever writing more: a stream that
+/// holds fewer bytes is "truncated", one that holds more is a size mismatch.
+/// Throws InputError(path, ...).
+void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected);
+/// gzip (wrapper = 16 + 15) or zlib (15) compression of a buffer.
+std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzip_wrapper, int level = 1);
+
+/// Reverses the byte order of `count` values of `width` bytes in place.
+void swap_bytes(std::byte* data, uint64_t count, size_t width);
+
+/// Throws LimitError(path, ...) if `bytes` exceeds the cap (0 = no cap).
+void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);
+/// dims product with overflow check; throws InputError on absurd dimensions.
+uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
+                       size_t value_size);
+
+/// Parses a floating-point number; throws InputError(path, what + ...) otherwise.
+double parse_double(const std::string& path, const std::string& text, const std::string& what);
+int64_t parse_int(const std::string& path, const std::string& text, const std::string& what);
+
+/// Writes a file atomically: `write` receives the path of a temporary file in
+/// the destination folder (same extension, so format-sniffing libraries see
+/// the right suffix); on success it is renamed over `path`, on any exception
+/// it is removed and the exception propagates. A reader of `path` therefore
+/// never sees a partial file, even if the process is killed.
+void write_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write);
+/// Same, with an ofstream opened in binary mode on the temporary file.
+void write_stream_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+}  // namespace voxpress::detail

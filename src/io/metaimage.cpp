@@ -1,0 +1,231 @@
+// MetaImage (.mha / .mhd) reader and writer.
+//
+// Header lines "Key = Value" up to ElementDataFile, which must come last:
+// LOCAL (data follows in the same file), a file name relative to the header,
+// or LIST (one file per slice on the following lines). CompressedData = True
+// means a zlib stream. TransformMatrix lists the direction of index axis 0,
+// then 1, then 2 (ITK's convention); coordinates are LPS (ITK's physical space).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "formats.h"
+#include "io_util.h"
+
+namespace voxpress::detail {
+namespace {
+
+ScalarType met_type(const std::string& path, const std::string& t) {
+  static const std::map<std::string, ScalarType> types = {
+      {"MET_UCHAR", ScalarType::u8},   {"MET_CHAR", ScalarType::i8},    {"MET_USHORT", ScalarType::u16},
+      {"MET_SHORT", ScalarType::i16},  {"MET_UINT", ScalarType::u32},   {"MET_INT", ScalarType::i32},
+      {"MET_ULONG", ScalarType::u32},  {"MET_LONG", ScalarType::i32},   {"MET_ULONG_LONG", ScalarType::u64},
+      {"MET_LONG_LONG", ScalarType::i64}, {"MET_FLOAT", ScalarType::f32}, {"MET_DOUBLE", ScalarType::f64}};
+  auto it = types.find(t);
+  if (it == types.end()) throw InputError(path, "unsupported MetaImage ElementType '" + t + "'");
+  return it->second;
+}
+
+const char* met_name(ScalarType t) {
+  switch (t) {
+    case ScalarType::u8: return "MET_UCHAR";
+    case ScalarType::i8: return "MET_CHAR";
+    case ScalarType::u16: return "MET_USHORT";
+    case ScalarType::i16: return "MET_SHORT";
+    case ScalarType::u32: return "MET_UINT";
+    case ScalarType::i32: return "MET_INT";
+    case ScalarType::u64: return "MET_ULONG_LONG";
+    case ScalarType::i64: return "MET_LONG_LONG";
+    case ScalarType::f32: return "MET_FLOAT";
+    default: return "MET_DOUBLE";
+  }
+}
+
+bool truthy(const std::string& s) {
+  const std::string l = lower(s);
+  return l == "true" || l == "1" || l == "yes";
+}
+
+std::vector<double> numbers(const std::string& path, const std::string& s, const std::string& key) {
+  std::vector<double> out;
+  for (const auto& t : split_ws(s)) out.push_back(parse_double(path, t, key));
+  return out;
+}
+
+}  // namespace
+
+ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
+  const uint64_t fsize = file_size(path);
+  const auto head = read_range(path, 0, std::min<uint64_t>(fsize, 1 << 20));
+  const std::string text(reinterpret_cast<const char*>(head.data()), head.size());
+  std::map<std::string, std::string> kv;  // keys lower-cased
+  std::vector<std::string> list_files;
+  uint64_t data_offset = 0;
+  bool found_data = false;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(pos, end - pos);
+    pos = std::min(end + 1, text.size());
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (trim(line).empty()) continue;
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) throw InputError(path, "malformed MetaImage header line '" + line + "'");
+    const std::string key = lower(trim(line.substr(0, eq)));
+    const std::string value = trim(line.substr(eq + 1));
+    kv[key] = value;
+    if (key == "elementdatafile") {
+      found_data = true;
+      data_offset = pos;
+      if (value.rfind("LIST", 0) == 0) {
+        while (pos < text.size()) {
+          size_t e = text.find('\n', pos);
+          if (e == std::string::npos) e = text.size();
+          const std::string f = trim(text.substr(pos, e - pos));
+          pos = std::min(e + 1, text.size());
+          if (!f.empty()) list_files.push_back(f);
+        }
+      }
+      break;
+    }
+  }
+  if (!found_data) throw InputError(path, "not a MetaImage file (no ElementDataFile line)");
+  auto get = [&](const char* k) -> const std::string* {
+    auto it = kv.find(k);
+    return it == kv.end() ? nullptr : &it->second;
+  };
+  ScalarVolume v;
+  v.source = path;
+  v.lattice.space = Space::LPS;
+  const std::string* ndims = get("ndims");
+  const std::string* dimsize = get("dimsize");
+  const std::string* etype = get("elementtype");
+  if (!ndims || !dimsize || !etype) throw InputError(path, "MetaImage header lacks NDims, DimSize or ElementType");
+  const int64_t nd = parse_int(path, *ndims, "NDims");
+  if (nd < 2 || nd > 3) throw InputError(path, "MetaImage with NDims = " + std::to_string(nd) + " is not supported");
+  const auto ds = numbers(path, *dimsize, "DimSize");
+  if (int64_t(ds.size()) != nd) throw InputError(path, "DimSize does not list NDims values");
+  for (int a = 0; a < 3; ++a) v.lattice.dims[size_t(a)] = a < nd ? int64_t(ds[size_t(a)]) : 1;
+  if (const auto* ch = get("elementnumberofchannels"); ch && parse_int(path, *ch, "ElementNumberOfChannels") != 1)
+    throw InputError(path, "multi-channel MetaImage is not supported");
+  v.type = met_type(path, *etype);
+  const std::string* sp = get("elementspacing");
+  if (!sp) sp = get("elementsize");
+  if (sp) {
+    const auto s = numbers(path, *sp, "ElementSpacing");
+    for (int a = 0; a < std::min<int>(int(nd), int(s.size())); ++a) v.lattice.spacing[a] = s[size_t(a)];
+  }
+  for (const char* k : {"offset", "origin", "position"})
+    if (const auto* o = get(k)) {
+      const auto s = numbers(path, *o, "Offset");
+      for (int a = 0; a < std::min<int>(int(nd), int(s.size())); ++a) v.lattice.origin[a] = s[size_t(a)];
+      break;
+    }
+  for (const char* k : {"transformmatrix", "rotation", "orientation"})
+    if (const auto* t = get(k)) {
+      const auto s = numbers(path, *t, "TransformMatrix");
+      if (int64_t(s.size()) != nd * nd) throw InputError(path, "TransformMatrix must have NDims^2 values");
+      for (int a = 0; a < nd; ++a)
+        for (int r = 0; r < nd; ++r) v.lattice.direction(r, a) = s[size_t(a * nd + r)];
+      if (nd == 2) v.lattice.direction.col(2) = Vec3::UnitZ();
+      break;
+    }
+  try {
+    v.lattice.validate();
+  } catch (const UsageError& e) {
+    throw InputError(path, e.what());
+  }
+  const size_t vs = scalar_size(v.type);
+  const uint64_t count = checked_count(path, v.lattice.dims, 1, vs);
+  const uint64_t bytes = count * vs;
+  check_limit(path, bytes, max_bytes, "the volume");
+  bool big = false;
+  for (const char* k : {"binarydatabyteordermsb", "elementbyteordermsb"})
+    if (const auto* b = get(k)) big = truthy(*b);
+  const bool compressed = get("compresseddata") && truthy(*get("compresseddata"));
+  int64_t header_size = 0;
+  if (const auto* hs = get("headersize")) header_size = parse_int(path, *hs, "HeaderSize");
+
+  const std::string& df = *get("elementdatafile");
+  const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  std::vector<std::pair<std::string, uint64_t>> sources;  // file, offset
+  if (df == "LOCAL") {
+    sources.push_back({path, data_offset});
+  } else if (df.rfind("LIST", 0) == 0) {
+    for (const auto& f : list_files) sources.push_back({(base / f).string(), 0});
+    if (sources.empty()) throw InputError(path, "ElementDataFile = LIST names no file");
+  } else if (split_ws(df).size() > 1) {
+    throw InputError(path, "MetaImage ElementDataFile patterns are not supported");
+  } else {
+    sources.push_back({(base / df).string(), 0});
+  }
+  v.bytes.resize(bytes);
+  if (compressed) {
+    std::vector<std::byte> z;
+    for (const auto& [file, off] : sources) {
+      const uint64_t fs = file_size(file);
+      if (off >= fs) throw InputError(file, "truncated: no compressed data");
+      check_limit(file, fs - off, max_bytes, "the compressed payload");
+      auto part = read_range(file, off, fs - off);
+      z.insert(z.end(), part.begin(), part.end());
+    }
+    if (const auto* cs = get("compresseddatasize")) {
+      const int64_t n = parse_int(path, *cs, "CompressedDataSize");
+      if (n > 0 && uint64_t(n) < z.size()) z.resize(size_t(n));
+    }
+    inflate_exact(path, z.data(), z.size(), v.bytes.data(), bytes);
+  } else {
+    if (sources.size() > 1 && bytes % sources.size()) throw InputError(path, "LIST files cannot split the data evenly");
+    const uint64_t per = bytes / sources.size();
+    for (size_t i = 0; i < sources.size(); ++i) {
+      const auto& [file, off0] = sources[i];
+      const uint64_t fs = file_size(file);
+      uint64_t off = off0;
+      if (header_size == -1)
+        off = fs >= per ? fs - per : 0;
+      else
+        off += uint64_t(std::max<int64_t>(header_size, 0));
+      const uint64_t avail = fs > off ? fs - off : 0;
+      if (avail < per)
+        throw InputError(file, "truncated: the header declares " + std::to_string(per) + " bytes of data but " +
+                                   std::to_string(avail) + " are present");
+      if (avail > per && header_size != -1)
+        throw InputError(file, "the data size does not match the header: " + std::to_string(avail) +
+                                   " bytes present, " + std::to_string(per) + " declared");
+      read_range_into(file, off, v.bytes.data() + i * per, per);
+    }
+  }
+  if (big && vs > 1) swap_bytes(v.bytes.data(), count, vs);
+  return v;
+}
+
+void write_metaimage(const std::string& path, const ScalarVolume& v, bool compress) {
+  if (v.components != 1) throw UsageError("MetaImage output holds one component per sample");
+  if (extension_of(path) != ".mha") throw UsageError("voxpress writes MetaImage as a single .mha file");
+  std::vector<std::byte> z;
+  if (compress) z = deflate_buffer(v.bytes.data(), v.bytes.size(), false);
+  std::ostringstream h;
+  h.precision(17);
+  h << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n";
+  h << "CompressedData = " << (compress ? "True" : "False") << "\n";
+  if (compress) h << "CompressedDataSize = " << z.size() << "\n";
+  h << "TransformMatrix =";
+  for (int a = 0; a < 3; ++a)
+    for (int r = 0; r < 3; ++r) h << " " << v.lattice.direction(r, a);
+  h << "\nOffset = " << v.lattice.origin.x() << " " << v.lattice.origin.y() << " " << v.lattice.origin.z() << "\n";
+  h << "ElementSpacing = " << v.lattice.spacing.x() << " " << v.lattice.spacing.y() << " " << v.lattice.spacing.z()
+    << "\n";
+  h << "DimSize = " << v.lattice.dims[0] << " " << v.lattice.dims[1] << " " << v.lattice.dims[2] << "\n";
+  h << "ElementType = " << met_name(v.type) << "\nElementDataFile = LOCAL\n";
+  const std::string header = h.str();
+  write_stream_atomically(path, [&](std::ostream& out) {
+    out.write(header.data(), std::streamsize(header.size()));
+    const auto& data = compress ? z : v.bytes;
+    out.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size()));
+  });
+}
+
+}  // namespace voxpress::detail

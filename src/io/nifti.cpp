@@ -1,0 +1,193 @@
+// NIfTI-1 / NIfTI-2 through nifti_clib (nifti2_io reads both versions).
+//
+// Geometry: the sform when sform_code > 0, else the qform when qform_code > 0,
+// else the pixdims (no orientation; "method 1" of the standard). Coordinates
+// are RAS. Data scaling (scl_slope != 0 and not identity) is applied, giving
+// float32 (or float64 for 64-bit input). Only 3-D data (a 4th dimension of 1)
+// is accepted; RGB and complex types are refused.
+#include <nifti2_io.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <mutex>
+
+#include "formats.h"
+#include "io_util.h"
+
+namespace voxpress::detail {
+namespace {
+
+struct NimDeleter {
+  void operator()(nifti_image* n) const {
+    if (n) nifti_image_free(n);
+  }
+};
+using NimPtr = std::unique_ptr<nifti_image, NimDeleter>;
+
+std::once_flag quiet_once;
+void quiet() {
+  std::call_once(quiet_once, [] { nifti_set_debug_level(0); });
+}
+
+ScalarType from_datatype(const std::string& path, int dt) {
+  switch (dt) {
+    case DT_UINT8: return ScalarType::u8;
+    case DT_INT8: return ScalarType::i8;
+    case DT_UINT16: return ScalarType::u16;
+    case DT_INT16: return ScalarType::i16;
+    case DT_UINT32: return ScalarType::u32;
+    case DT_INT32: return ScalarType::i32;
+    case DT_UINT64: return ScalarType::u64;
+    case DT_INT64: return ScalarType::i64;
+    case DT_FLOAT32: return ScalarType::f32;
+    case DT_FLOAT64: return ScalarType::f64;
+    default:
+      throw InputError(path, std::string("unsupported NIfTI voxel type ") + nifti_datatype_string(dt) +
+                                 " (integers and float32/64 only)");
+  }
+}
+
+int to_datatype(ScalarType t) {
+  switch (t) {
+    case ScalarType::u8: return DT_UINT8;
+    case ScalarType::i8: return DT_INT8;
+    case ScalarType::u16: return DT_UINT16;
+    case ScalarType::i16: return DT_INT16;
+    case ScalarType::u32: return DT_UINT32;
+    case ScalarType::i32: return DT_INT32;
+    case ScalarType::u64: return DT_UINT64;
+    case ScalarType::i64: return DT_INT64;
+    case ScalarType::f32: return DT_FLOAT32;
+    default: return DT_FLOAT64;
+  }
+}
+
+}  // namespace
+
+ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
+  quiet();
+  const uint64_t fsize = file_size(path);
+  const std::string ext = extension_of(path);
+  if (ext != ".nii.gz" && fsize < 348) throw InputError(path, "truncated: too small for a NIfTI header");
+  NimPtr nim(nifti_image_read(path.c_str(), 0));
+  if (!nim) throw InputError(path, "not a readable NIfTI-1/2 file (bad or truncated header)");
+  ScalarVolume v;
+  v.source = path;
+  for (int d = 4; d <= 7; ++d)
+    if (nim->dim[0] >= d && nim->dim[d] > 1)
+      throw InputError(path, "NIfTI with " + std::to_string(nim->dim[d]) + " volumes along dimension " +
+                                 std::to_string(d) + " is not supported (3-D only)");
+  v.type = from_datatype(path, nim->datatype);
+  v.lattice.dims = {nim->nx, nim->dim[0] >= 2 ? nim->ny : 1, nim->dim[0] >= 3 ? nim->nz : 1};
+  const size_t vs = scalar_size(v.type);
+  const uint64_t count = checked_count(path, v.lattice.dims, 1, vs);
+  if (uint64_t(nim->nvox) != count) throw InputError(path, "inconsistent NIfTI dimensions");
+  check_limit(path, count * vs, max_bytes, "the volume");
+  // For an uncompressed single file the payload size is known up front.
+  if (ext == ".nii" && nim->iname && std::strcmp(nim->iname, nim->fname) == 0) {
+    const uint64_t need = uint64_t(nim->iname_offset) + count * vs;
+    if (fsize < need)
+      throw InputError(path, "truncated: the header declares " + std::to_string(count * vs) + " bytes of data at offset " +
+                                 std::to_string(nim->iname_offset) + " but the file has " + std::to_string(fsize) +
+                                 " bytes");
+  }
+  // Geometry.
+  nifti_dmat44 m;
+  if (nim->sform_code > 0) {
+    m = nim->sto_xyz;
+    v.lattice.space = Space::RAS;
+  } else if (nim->qform_code > 0) {
+    m = nim->qto_xyz;
+    v.lattice.space = Space::RAS;
+  } else {
+    std::memset(&m, 0, sizeof m);
+    m.m[0][0] = nim->dx > 0 ? nim->dx : 1;
+    m.m[1][1] = nim->dy > 0 ? nim->dy : 1;
+    m.m[2][2] = nim->dz > 0 ? nim->dz : 1;
+  }
+  for (int a = 0; a < 3; ++a) {
+    Vec3 col(m.m[0][a], m.m[1][a], m.m[2][a]);
+    const double len = col.norm();
+    if (!(len > 0) || !std::isfinite(len)) throw InputError(path, "degenerate NIfTI orientation matrix");
+    v.lattice.spacing[a] = len;
+    v.lattice.direction.col(a) = col / len;
+    v.lattice.origin[a] = m.m[a][3];
+  }
+  try {
+    v.lattice.validate();
+  } catch (const UsageError& e) {
+    throw InputError(path, e.what());
+  }
+  if (nifti_image_load(nim.get()) != 0 || !nim->data)
+    throw InputError(path, "truncated or corrupt NIfTI image data");
+  const bool scaled = nim->scl_slope != 0 && std::isfinite(nim->scl_slope) &&
+                      (nim->scl_slope != 1 || nim->scl_inter != 0);
+  if (!scaled) {
+    v.bytes.resize(count * vs);
+    std::memcpy(v.bytes.data(), nim->data, count * vs);
+    return v;
+  }
+  // Apply the scaling: y = slope * x + inter.
+  ScalarVolume raw = v;
+  raw.bytes.assign(static_cast<const std::byte*>(nim->data), static_cast<const std::byte*>(nim->data) + count * vs);
+  const double slope = nim->scl_slope, inter = nim->scl_inter;
+  nim.reset();
+  v.type = vs == 8 ? ScalarType::f64 : ScalarType::f32;
+  v.bytes.resize(count * scalar_size(v.type));
+  raw.visit([&](auto values) {
+    if (v.type == ScalarType::f64) {
+      auto* out = reinterpret_cast<double*>(v.bytes.data());
+      for (uint64_t i = 0; i < count; ++i) out[i] = slope * double(values[i]) + inter;
+    } else {
+      auto* out = reinterpret_cast<float*>(v.bytes.data());
+      for (uint64_t i = 0; i < count; ++i) out[i] = float(slope * double(values[i]) + inter);
+    }
+  });
+  v.metadata["scl_slope"] = std::to_string(slope);
+  v.metadata["scl_inter"] = std::to_string(inter);
+  return v;
+}
+
+void write_nifti(const std::string& path, const ScalarVolume& v) {
+  quiet();
+  if (v.components != 1) throw UsageError("NIfTI output holds one component per sample");
+  const int64_t dims[8] = {3, v.lattice.dims[0], v.lattice.dims[1], v.lattice.dims[2], 1, 1, 1, 1};
+  NimPtr nim(nifti_make_new_nim(dims, to_datatype(v.type), 0));
+  if (!nim) throw Error("nifti_clib could not create an image");
+  // Physical transform in RAS.
+  Mat3 M = v.lattice.index_to_physical_matrix();
+  Vec3 o = v.lattice.origin;
+  if (v.lattice.space == Space::LPS) {
+    M.row(0) *= -1;
+    M.row(1) *= -1;
+    o.x() = -o.x();
+    o.y() = -o.y();
+  }
+  nim->dx = nim->pixdim[1] = v.lattice.spacing[0];
+  nim->dy = nim->pixdim[2] = v.lattice.spacing[1];
+  nim->dz = nim->pixdim[3] = v.lattice.spacing[2];
+  nim->sform_code = NIFTI_XFORM_SCANNER_ANAT;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) nim->sto_xyz.m[r][c] = M(r, c);
+    nim->sto_xyz.m[r][3] = o[r];
+  }
+  nim->sto_xyz.m[3][0] = nim->sto_xyz.m[3][1] = nim->sto_xyz.m[3][2] = 0;
+  nim->sto_xyz.m[3][3] = 1;
+  // Also a qform when the matrix is a rotation times spacing (the usual case).
+  nim->qform_code = NIFTI_XFORM_SCANNER_ANAT;
+  nifti_dmat44_to_quatern(nim->sto_xyz, &nim->quatern_b, &nim->quatern_c, &nim->quatern_d, &nim->qoffset_x,
+                          &nim->qoffset_y, &nim->qoffset_z, nullptr, nullptr, nullptr, &nim->qfac);
+  nim->qto_xyz = nim->sto_xyz;
+  write_atomically(path, [&](const std::string& tmp) {
+    if (nifti_set_filenames(nim.get(), tmp.c_str(), 0, 1) != 0) throw InputError(path, "invalid NIfTI file name");
+    nim->data = const_cast<std::byte*>(v.bytes.data());
+    nifti_image_write(nim.get());
+    nim->data = nullptr;
+    std::error_code ec;
+    if (!std::filesystem::exists(tmp, ec) || std::filesystem::file_size(tmp, ec) == 0)
+      throw InputError(path, "nifti_clib failed to write the file");
+  });
+}
+
+}  // namespace voxpress::detail

@@ -1,0 +1,183 @@
+// OBJ (tinyobjloader, double precision) and glTF 2.0 / GLB (tinygltf).
+#include <tiny_gltf.h>
+#include <tiny_obj_loader.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+
+#include "formats.h"
+#include "io_util.h"
+
+namespace voxpress::detail {
+namespace {
+std::string fmt(double x) {
+  char tmp[32];
+  auto r = std::to_chars(tmp, tmp + 32, x);
+  return std::string(tmp, r.ptr);
+}
+}  // namespace
+
+Mesh read_obj(const std::string& path, uint64_t max_bytes) {
+  const uint64_t fs = file_size(path);
+  check_limit(path, fs * 4, max_bytes, "parsing the OBJ file");
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn, err;
+  const std::string base = std::filesystem::path(path).parent_path().string() + "/";
+  if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, path.c_str(), base.c_str(), true, false)) {
+    std::string e = trim(err);
+    if (const auto nl = e.find('\n'); nl != std::string::npos) e = e.substr(0, nl);
+    throw InputError(path, "cannot parse OBJ" + (e.empty() ? "" : " (" + e + ")"));
+  }
+  Mesh m;
+  const size_t nv = attrib.vertices.size() / 3;
+  m.positions.resize(nv);
+  for (size_t v = 0; v < nv; ++v)
+    m.positions[v] = Vec3(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
+  for (const auto& sh : shapes) {
+    size_t offset = 0;
+    for (size_t f = 0; f < sh.mesh.num_face_vertices.size(); ++f) {
+      const size_t n = sh.mesh.num_face_vertices[f];
+      if (n < 3) throw InputError(path, "OBJ face with fewer than 3 vertices");
+      for (size_t q = 1; q + 1 < n; ++q) {
+        Triangle t;
+        const size_t corners[3] = {offset, offset + q, offset + q + 1};
+        for (int c = 0; c < 3; ++c) {
+          const int idx = sh.mesh.indices[corners[c]].vertex_index;
+          if (idx < 0 || size_t(idx) >= nv) throw InputError(path, "OBJ face uses a missing vertex");
+          t[size_t(c)] = uint32_t(idx);
+        }
+        m.triangles.push_back(t);
+      }
+      offset += n;
+    }
+  }
+  if (m.triangles.empty()) throw InputError(path, "the OBJ file holds no faces");
+  m.validate(path);
+  return m;
+}
+
+void write_obj(const std::string& path, const Mesh& m) {
+  m.validate(path);
+  write_stream_atomically(path, [&](std::ostream& out) {
+    std::string buf = "# written by voxpress\n";
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+      const Vec3& p = m.positions[v];
+      buf += "v " + fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z());
+      if (!m.colors.empty())
+        for (int c = 0; c < 3; ++c) buf += " " + fmt(m.colors[v][size_t(c)] / 255.0);
+      buf += "\n";
+      if (buf.size() > (1 << 20)) {
+        out << buf;
+        buf.clear();
+      }
+    }
+    const bool vn = !m.normals.empty();
+    if (vn)
+      for (const Vec3& n : m.normals) buf += "vn " + fmt(n.x()) + " " + fmt(n.y()) + " " + fmt(n.z()) + "\n";
+    for (const Triangle& t : m.triangles) {
+      buf += "f";
+      for (uint32_t i : t) buf += " " + std::to_string(i + 1) + (vn ? "//" + std::to_string(i + 1) : "");
+      buf += "\n";
+      if (buf.size() > (1 << 20)) {
+        out << buf;
+        buf.clear();
+      }
+    }
+    out << buf;
+  });
+}
+
+void write_gltf(const std::string& path, const Mesh& m, bool binary) {
+  m.validate(path);
+  if (m.triangles.empty()) throw UsageError(path + ": glTF output needs at least one triangle");
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "voxpress";
+  tinygltf::Buffer buffer;
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  auto add_view = [&](const void* data, size_t bytes, int target) {
+    while (buffer.data.size() % 4) buffer.data.push_back(0);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.data.size();
+    view.byteLength = bytes;
+    view.target = target;
+    const auto* b = static_cast<const unsigned char*>(data);
+    buffer.data.insert(buffer.data.end(), b, b + bytes);
+    model.bufferViews.push_back(view);
+    return int(model.bufferViews.size() - 1);
+  };
+  auto add_accessor = [&](int view, int component, size_t count, int type, bool normalized = false) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.componentType = component;
+    a.count = count;
+    a.type = type;
+    a.normalized = normalized;
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
+  };
+  // Positions (float32, with the bounds the specification requires).
+  std::vector<float> pos(3 * m.positions.size());
+  std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
+  for (size_t v = 0; v < m.positions.size(); ++v)
+    for (int a = 0; a < 3; ++a) {
+      pos[3 * v + size_t(a)] = float(m.positions[v][a]);
+      lo[size_t(a)] = std::min(lo[size_t(a)], double(pos[3 * v + size_t(a)]));
+      hi[size_t(a)] = std::max(hi[size_t(a)], double(pos[3 * v + size_t(a)]));
+    }
+  int acc = add_accessor(add_view(pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                         TINYGLTF_COMPONENT_TYPE_FLOAT, m.positions.size(), TINYGLTF_TYPE_VEC3);
+  model.accessors[size_t(acc)].minValues = lo;
+  model.accessors[size_t(acc)].maxValues = hi;
+  prim.attributes["POSITION"] = acc;
+  if (!m.normals.empty()) {
+    std::vector<float> n(3 * m.normals.size());
+    for (size_t v = 0; v < m.normals.size(); ++v) {
+      Vec3 u = m.normals[v];
+      const double len = u.norm();
+      u = len > 0 ? Vec3(u / len) : Vec3(0, 0, 1);
+      for (int a = 0; a < 3; ++a) n[3 * v + size_t(a)] = float(u[a]);
+    }
+    prim.attributes["NORMAL"] = add_accessor(add_view(n.data(), n.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                             TINYGLTF_COMPONENT_TYPE_FLOAT, m.normals.size(), TINYGLTF_TYPE_VEC3);
+  }
+  if (!m.colors.empty())
+    prim.attributes["COLOR_0"] =
+        add_accessor(add_view(m.colors.data(), m.colors.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, m.colors.size(), TINYGLTF_TYPE_VEC4, true);
+  prim.indices = add_accessor(add_view(m.triangles.data(), m.triangles.size() * 12, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, m.triangles.size() * 3, TINYGLTF_TYPE_SCALAR);
+  tinygltf::Material mat;
+  mat.name = "voxpress";
+  mat.pbrMetallicRoughness.baseColorFactor = {0.8, 0.8, 0.8, 1.0};
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = 0.8;
+  mat.doubleSided = false;
+  model.materials.push_back(mat);
+  prim.material = 0;
+  tinygltf::Mesh mesh;
+  mesh.name = "voxpress";
+  mesh.primitives.push_back(prim);
+  model.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.mesh = 0;
+  model.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes.push_back(0);
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+  model.buffers.push_back(std::move(buffer));
+  write_stream_atomically(path, [&](std::ostream& out) {
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary)) throw InputError(path, "glTF writer failed");
+  });
+}
+
+}  // namespace voxpress::detail

@@ -1,0 +1,189 @@
+// The voxpress command line: each command works, and each kind of bad input
+// gives one line naming the file, a non-zero exit code and no output file.
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+#include "test_util.h"
+
+namespace voxpress {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+
+size_t count_lines(const std::string& s) {
+  size_t n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST(Cli, HelpOnEveryCommand) {
+  for (const std::string cmd : {"", "info", "extract", "generate", "check"}) {
+    std::string out;
+    EXPECT_EQ(run_cli(cmd + " --help", &out), 0) << cmd;
+    EXPECT_NE(out.find("Usage"), std::string::npos) << cmd;
+  }
+  std::string out;
+  EXPECT_EQ(run_cli("--version", &out), 0);
+  EXPECT_NE(out.find("voxpress"), std::string::npos);
+}
+
+TEST(Cli, GenerateInfoExtractCheckPipeline) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate torus --res 40 --rotate random:3 --spacing 1,1,1.5 -o " + tmp.path("t.nrrd"), &out), 0)
+      << out;
+  ASSERT_EQ(run_cli("info " + tmp.path("t.nrrd") + " --json " + tmp.path("info.json"), &out), 0) << out;
+  EXPECT_NE(out.find("sticks"), std::string::npos);
+  const auto info = nlohmann::json::parse(std::ifstream(tmp.path("info.json")));
+  EXPECT_EQ(info["lattice"]["spacing"][2], 1.5);
+  EXPECT_GT(info["sticks"].get<uint64_t>(), 0u);
+  for (const std::string fmt : {"ply", "obj", "stl", "off", "glb", "gltf"}) {
+    ASSERT_EQ(run_cli("-q extract " + tmp.path("t.nrrd") + " -o " + tmp.path("t." + fmt) + " --stats-json " +
+                          tmp.path("s.json"),
+                      &out),
+              0)
+        << out;
+    EXPECT_TRUE(fs::exists(tmp.path("t." + fmt)));
+  }
+  const auto stats = nlohmann::json::parse(std::ifstream(tmp.path("s.json")));
+  EXPECT_EQ(stats["counts"]["vertices"], stats["counts"]["sticks"]);
+  EXPECT_EQ(stats["counts"]["sticks"], info["sticks"]);
+  EXPECT_GT(stats["seconds"]["total"].get<double>(), 0);
+  ASSERT_EQ(run_cli("check " + tmp.path("t.ply") + " --volume " + tmp.path("t.nrrd") + " --json " + tmp.path("c.json"),
+                    &out),
+            0)
+      << out;
+  const auto check = nlohmann::json::parse(std::ifstream(tmp.path("c.json")));
+  EXPECT_EQ(check["ok"], true);
+  EXPECT_EQ(check["euler_characteristic"], 0);
+  EXPECT_EQ(check["classification"]["violations"], 0);
+  // A mesh that does not separate the samples fails the check with exit code 1.
+  ASSERT_EQ(run_cli("-q generate sphere --res 40 -o " + tmp.path("s.nrrd"), &out), 0);
+  EXPECT_EQ(run_cli("check " + tmp.path("t.ply") + " --volume " + tmp.path("s.nrrd"), &out), 1);
+  EXPECT_NE(out.find("FAILED"), std::string::npos);
+  // Thread count does not change the output bytes.
+  ASSERT_EQ(run_cli("-q --threads 1 extract " + tmp.path("t.nrrd") + " -o " + tmp.path("one.ply")), 0);
+  ASSERT_EQ(run_cli("-q --threads 2 extract " + tmp.path("t.nrrd") + " -o " + tmp.path("two.ply")), 0);
+  std::ifstream a(tmp.path("one.ply"), std::ios::binary), b(tmp.path("two.ply"), std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(a), {}), std::string(std::istreambuf_iterator<char>(b), {}));
+}
+
+TEST(Cli, LabelsThresholdsAndRawInputs) {
+  test::TempDir tmp;
+  // A two-label volume written through the library.
+  ScalarVolume v;
+  v.lattice.dims = {6, 6, 6};
+  v.type = ScalarType::u8;
+  v.bytes.assign(216, std::byte{0});
+  for (int i = 0; i < 216; ++i) {
+    const int x = i % 6, y = (i / 6) % 6, z = i / 36;
+    if (x > 0 && x < 3 && y > 0 && y < 5 && z > 0 && z < 5) v.bytes[size_t(i)] = std::byte{1};
+    if (x > 3 && x < 5 && y > 0 && y < 5 && z > 0 && z < 5) v.bytes[size_t(i)] = std::byte{2};
+  }
+  write_volume(tmp.path("labels.nrrd"), v);
+  std::string out;
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("labels.nrrd") + " -o " + tmp.path("x.ply"), &out), 1);
+  EXPECT_NE(out.find("--label"), std::string::npos);
+  EXPECT_EQ(count_lines(out), 1u) << out;
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("labels.nrrd") + " --label 2 -o " + tmp.path("two.ply"), &out), 0) << out;
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("labels.nrrd") + " --label all-nonzero -o " + tmp.path("all.ply"), &out), 0);
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("labels.nrrd") + " --threshold 1.5 -o " + tmp.path("th.ply"), &out), 0);
+  EXPECT_EQ(read_mesh(tmp.path("two.ply")).positions.size(), read_mesh(tmp.path("th.ply")).positions.size());
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("labels.nrrd") + " --label 2 --threshold 1 -o " + tmp.path("y.ply"), &out),
+            2);
+  // Raw input with an explicit layout.
+  std::ofstream(tmp.path("v.raw"), std::ios::binary).write(reinterpret_cast<const char*>(v.bytes.data()), 216);
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("v.raw") + " --raw-dims 6,6,6 --raw-type uint8 --label 1 -o " +
+                        tmp.path("raw.ply"),
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("v.raw") + " --raw-dims 6,6,7 --label 1 -o " + tmp.path("raw2.ply"), &out),
+            1);
+  EXPECT_NE(out.find("truncated"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q extract " + tmp.path("v.raw") + " -o " + tmp.path("raw3.ply"), &out), 2);
+}
+
+// Each bad input: exit code, one line naming the file and the problem, nothing written.
+TEST(Cli, BadInputsFailCleanly) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate sphere --res 24 -o " + tmp.path("s.nrrd"), &out), 0);
+  ASSERT_EQ(run_cli("-q generate sphere --res 24 -o " + tmp.path("s.nii"), &out), 0);
+  // Truncated copies.
+  auto truncated = [&](const std::string& src, const std::string& dst, uintmax_t cut) {
+    fs::copy_file(tmp.path(src), tmp.path(dst));
+    fs::resize_file(tmp.path(dst), fs::file_size(tmp.path(dst)) - cut);
+  };
+  ScalarVolume raw = to_scalar(binarize(read_volume(tmp.path("s.nrrd"))));
+  WriteVolumeOptions plain;
+  plain.compress = false;
+  write_volume(tmp.path("raw.nrrd"), raw, plain);
+  truncated("raw.nrrd", "trunc.nrrd", 500);
+  truncated("s.nrrd", "truncgz.nrrd", 50);
+  truncated("s.nii", "trunc.nii", 500);
+  std::ofstream(tmp.path("mismatch.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\n" << std::string(100, '\1');
+  std::ofstream(tmp.path("huge.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 100000 100000 100000\nencoding: gzip\n\n" << std::string(10, '\0');
+  std::ofstream(tmp.path("empty.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\n" << std::string(64, '\0');
+  std::ofstream(tmp.path("full.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\n" << std::string(64, '\1');
+  std::ofstream(tmp.path("weird.abc")) << "abc";
+  struct Bad {
+    std::string args, file, problem;
+    int code;
+  };
+  const Bad cases[] = {
+      {"extract " + tmp.path("nope.nrrd"), "nope.nrrd", "no such file", 1},
+      {"extract " + tmp.path("weird.abc"), "weird.abc", "unknown volume format", 1},
+      {"extract " + tmp.path("trunc.nrrd"), "trunc.nrrd", "truncated", 1},
+      {"extract " + tmp.path("truncgz.nrrd"), "truncgz.nrrd", "truncated", 1},
+      {"extract " + tmp.path("trunc.nii"), "trunc.nii", "truncated", 1},
+      {"extract " + tmp.path("mismatch.nrrd"), "mismatch.nrrd", "does not match", 1},
+      {"extract " + tmp.path("huge.nrrd"), "huge.nrrd", "memory limit", 1},
+      {"--max-memory 10K extract " + tmp.path("raw.nrrd"), "raw.nrrd", "memory limit", 1},
+      {"extract " + tmp.path("empty.nrrd"), "empty.nrrd", "empty", 1},
+      {"extract " + tmp.path("full.nrrd"), "full.nrrd", "full", 1},
+      {"check " + tmp.path("nope.ply"), "nope.ply", "no such file", 1},
+      {"info " + tmp.path("trunc.nrrd"), "trunc.nrrd", "truncated", 1},
+  };
+  for (const Bad& b : cases) {
+    SCOPED_TRACE(b.args);
+    const auto before = tmp.files();
+    const std::string args = b.args.rfind("check", 0) == 0 || b.args.rfind("info", 0) == 0
+                                 ? b.args
+                                 : b.args + " -o " + tmp.path("out.ply");
+    EXPECT_EQ(run_cli("-q " + args, &out), b.code) << out;
+    EXPECT_EQ(count_lines(out), 1u) << out;
+    EXPECT_NE(out.find(b.file), std::string::npos) << out;
+    EXPECT_NE(out.find(b.problem), std::string::npos) << out;
+    EXPECT_EQ(tmp.files(), before) << "an output or temporary file was left behind";
+  }
+  // Usage errors exit with 2.
+  EXPECT_EQ(run_cli("extract " + tmp.path("s.nrrd"), &out), 2);  // no -o
+  EXPECT_EQ(run_cli("generate blob -o " + tmp.path("b.nrrd"), &out), 2);
+  EXPECT_EQ(run_cli("generate sphere --res 3 -o " + tmp.path("b.nrrd"), &out), 2);
+  EXPECT_EQ(run_cli("frobnicate", &out), 2);
+  EXPECT_EQ(run_cli("extract " + tmp.path("s.nrrd") + " -o " + tmp.path("out.xyz"), &out), 1);
+  EXPECT_NE(out.find("out.xyz"), std::string::npos);
+  EXPECT_FALSE(fs::exists(tmp.path("out.ply")));
+}
+
+TEST(Cli, SharedLabelMapsPerLabel) {
+  VOXPRESS_REQUIRE_SHARED_DATA();
+  test::TempDir tmp;
+  const std::string f = test::shared_data() + "/medical/totalseg_example_seg_fast_force_split.nii.gz";
+  std::string out;
+  ASSERT_EQ(run_cli("-q extract " + f + " --label 5 -o " + tmp.path("liver.stl") + " --check", &out), 0) << out;
+  ASSERT_EQ(run_cli("check " + tmp.path("liver.stl") + " --volume " + f + " --label 5", &out), 0) << out;
+  EXPECT_NE(out.find("0 violations"), std::string::npos);
+  EXPECT_EQ(run_cli("-q extract " + f + " --label 4242 -o " + tmp.path("none.stl"), &out), 1);
+  EXPECT_NE(out.find("4242"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace voxpress

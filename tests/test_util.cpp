@@ -1,0 +1,166 @@
+#include "test_util.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <sys/wait.h>
+
+namespace voxpress::test {
+
+namespace fs = std::filesystem;
+
+TempDir::TempDir() {
+  static std::atomic<int> counter{0};
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "voxpress";
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.') c = '_';
+  dir_ = fs::temp_directory_path() / ("voxpress-test-" + std::to_string(::getpid()) + "-" +
+                                      std::to_string(counter++) + "-" + name);
+  fs::remove_all(dir_);
+  fs::create_directories(dir_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+}
+
+std::vector<std::string> TempDir::files() const {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir_)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::string shared_data() {
+  if (const char* env = std::getenv("VOXPRESS_SHARED_DATA"); env && *env) return fs::exists(env) ? env : "";
+  const fs::path p = fs::path(VOXPRESS_SOURCE_DIR) / ".." / "shared" / "data";
+  return fs::exists(p / "README.md") ? fs::canonical(p).string() : "";
+}
+
+uint64_t Rng::next() {
+  uint64_t z = (s_ += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+BinaryVolume make_volume(int64_t nx, int64_t ny, int64_t nz) {
+  BinaryVolume v;
+  v.lattice.dims = {nx, ny, nz};
+  v.inside.assign(size_t(nx * ny * nz), 0);
+  v.source = "test volume";
+  return v;
+}
+
+BinaryVolume random_noise(Rng& rng, std::array<int64_t, 3> d, double density) {
+  BinaryVolume v = make_volume(d[0], d[1], d[2]);
+  for (auto& x : v.inside) x = rng.uniform() < density ? 1 : 0;
+  return v;
+}
+
+BinaryVolume random_blobs(Rng& rng, std::array<int64_t, 3> d, int blobs) {
+  BinaryVolume v = make_volume(d[0], d[1], d[2]);
+  for (int b = 0; b < blobs; ++b) {
+    const Vec3 c(rng.uniform() * double(d[0]), rng.uniform() * double(d[1]), rng.uniform() * double(d[2]));
+    const double r = 1 + rng.uniform() * double(std::min({d[0], d[1], d[2]})) / 3;
+    for (int64_t k = 0; k < d[2]; ++k)
+      for (int64_t j = 0; j < d[1]; ++j)
+        for (int64_t i = 0; i < d[0]; ++i)
+          if ((Vec3(double(i), double(j), double(k)) - c).norm() <= r) v.inside[v.lattice.linear(i, j, k)] = 1;
+  }
+  return v;
+}
+
+BinaryVolume checkerboard(std::array<int64_t, 3> d, int period_axes) {
+  BinaryVolume v = make_volume(d[0], d[1], d[2]);
+  for (int64_t k = 0; k < d[2]; ++k)
+    for (int64_t j = 0; j < d[1]; ++j)
+      for (int64_t i = 0; i < d[0]; ++i) {
+        const int64_t s = ((period_axes & 1) ? i : 0) + ((period_axes & 2) ? j : 0) + ((period_axes & 4) ? k : 0);
+        v.inside[v.lattice.linear(i, j, k)] = s % 2 == 0 ? 1 : 0;
+      }
+  return v;
+}
+
+std::vector<Case> property_volumes() {
+  std::vector<Case> out;
+  Rng rng(2024);
+  // Every single-cell configuration (all 256 cube cases, touching the border).
+  for (unsigned mask = 1; mask < 256; ++mask) {
+    BinaryVolume v = make_volume(2, 2, 2);
+    for (int c = 0; c < 8; ++c) v.inside[size_t((c & 1) + 2 * ((c >> 1) & 1) + 4 * ((c >> 2) & 1))] = (mask >> c) & 1;
+    out.push_back({"cube case " + std::to_string(mask), v});
+  }
+  // Random noise at several densities and sizes.
+  for (double density : {0.1, 0.3, 0.5, 0.7, 0.9})
+    for (int s = 0; s < 16; ++s) {
+      const std::array<int64_t, 3> d{rng.range(3, 12), rng.range(3, 12), rng.range(3, 12)};
+      out.push_back({"noise " + std::to_string(density) + " #" + std::to_string(s), random_noise(rng, d, density)});
+    }
+  // Random blobs (smooth-ish organic unions).
+  for (int s = 0; s < 20; ++s) {
+    const std::array<int64_t, 3> d{rng.range(8, 20), rng.range(8, 20), rng.range(8, 20)};
+    out.push_back({"blobs #" + std::to_string(s), random_blobs(rng, d, int(rng.range(1, 6)))});
+  }
+  // Checkerboards: 3D (corner contacts everywhere), 2D and 1D stripes.
+  for (int axes = 1; axes < 8; ++axes) out.push_back({"checkerboard " + std::to_string(axes), checkerboard({7, 6, 5}, axes)});
+  // Single voxels, including in corners and on the border, and 1-sample volumes.
+  out.push_back({"1x1x1 inside", [] { auto v = make_volume(1, 1, 1); v.inside[0] = 1; return v; }()});
+  for (int s = 0; s < 10; ++s) {
+    BinaryVolume v = make_volume(4, 5, 3);
+    v.inside[size_t(rng.range(0, int64_t(v.inside.size()) - 1))] = 1;
+    out.push_back({"single voxel #" + std::to_string(s), v});
+  }
+  // Pairs touching only along an edge or at a corner (non-manifold voxel configurations).
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        if (std::abs(dx) + std::abs(dy) + std::abs(dz) < 2) continue;
+        BinaryVolume v = make_volume(5, 5, 5);
+        v.inside[v.lattice.linear(2, 2, 2)] = 1;
+        v.inside[v.lattice.linear(2 + dx, 2 + dy, 2 + dz)] = 1;
+        out.push_back({"diagonal pair " + std::to_string(dx) + "," + std::to_string(dy) + "," + std::to_string(dz), v});
+      }
+  // Noise whose border layer is inside (surface closes around the grid).
+  for (int s = 0; s < 10; ++s) {
+    BinaryVolume v = random_noise(rng, {6, 7, 8}, 0.5);
+    for (int64_t k = 0; k < 8; ++k)
+      for (int64_t j = 0; j < 7; ++j)
+        for (int64_t i = 0; i < 6; ++i)
+          if (i == 0 || j == 0 || k == 0 || i == 5 || j == 6 || k == 7) v.inside[v.lattice.linear(i, j, k)] = 1;
+    out.push_back({"border noise #" + std::to_string(s), v});
+  }
+  // Thin structures: 1-sample-thick planes and lines.
+  for (int s = 0; s < 6; ++s) {
+    BinaryVolume v = make_volume(1 + s, 6, 1);
+    for (auto& x : v.inside) x = rng.uniform() < 0.6 ? 1 : 0;
+    out.push_back({"flat sheet #" + std::to_string(s), v});
+  }
+  // Generated shapes at random rotations.
+  for (ShapeKind k : all_shapes())
+    for (int seed = 0; seed < 4; ++seed) {
+      GenerateOptions o;
+      o.res = 20 + 6 * seed;
+      o.rotation = parse_rotation("random:" + std::to_string(seed * 31 + 7));
+      out.push_back({std::string(shape_name(k)) + " seed " + std::to_string(seed), generate_shape(k, o).volume});
+    }
+  return out;
+}
+
+int run_cli(const std::string& args, std::string* output) {
+  const std::string cmd = std::string(VOXPRESS_CLI) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return -1;
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int status = ::pclose(p);
+  if (output) *output = out;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace voxpress::test

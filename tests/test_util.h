@@ -1,0 +1,71 @@
+// Helpers shared by the tests: temporary folders, random and adversarial
+// volumes, the shared data folder, running the CLI.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "voxpress/voxpress.h"
+
+namespace voxpress::test {
+
+/// A fresh, empty folder removed at the end of the test.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  const std::filesystem::path& dir() const { return dir_; }
+  /// Names of the files the folder holds (to assert nothing partial was left).
+  std::vector<std::string> files() const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
+/// ../shared/data next to the repository, or "" when absent.
+std::string shared_data();
+/// Skips the current test with a message when ../shared/data is absent.
+#define VOXPRESS_REQUIRE_SHARED_DATA()                                                          \
+  do {                                                                                          \
+    if (voxpress::test::shared_data().empty())                                                   \
+      GTEST_SKIP() << "../shared/data is absent (clone it beside the repository to run this)"; \
+  } while (0)
+
+/// Deterministic generator (splitmix64), independent of the standard library.
+class Rng {
+ public:
+  explicit Rng(uint64_t seed) : s_(seed * 0x9e3779b97f4a7c15ull + 1) {}
+  uint64_t next();
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+  int64_t range(int64_t lo, int64_t hi) { return lo + int64_t(next() % uint64_t(hi - lo + 1)); }
+
+ private:
+  uint64_t s_;
+};
+
+BinaryVolume make_volume(int64_t nx, int64_t ny, int64_t nz);
+BinaryVolume random_noise(Rng& rng, std::array<int64_t, 3> dims, double density);
+BinaryVolume random_blobs(Rng& rng, std::array<int64_t, 3> dims, int blobs);
+/// Inside where (i + j + k) % 2 == 0 (every neighbour pair differs).
+BinaryVolume checkerboard(std::array<int64_t, 3> dims, int period_axes = 7);
+
+/// A named volume for property tests.
+struct Case {
+  std::string name;
+  BinaryVolume volume;
+};
+/// The Foundation property-test corpus: hundreds of random, adversarial and
+/// generated volumes (also reused by later methods' property tests).
+std::vector<Case> property_volumes();
+
+/// Runs the voxpress CLI with `args`; returns the exit code, fills output
+/// with stdout and stderr combined.
+int run_cli(const std::string& args, std::string* output = nullptr);
+
+}  // namespace voxpress::test
