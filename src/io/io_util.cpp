@@ -176,6 +176,12 @@ uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& di
   return n;
 }
 
+std::string format_double(double x) {
+  char tmp[32];
+  const auto r = std::to_chars(tmp, tmp + sizeof tmp, x);
+  return std::string(tmp, r.ptr);
+}
+
 double parse_double(const std::string& path, const std::string& text, const std::string& what) {
   const std::string t = trim(text);
   double v = 0;

@@ -45,6 +45,9 @@ void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const st
 uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
                        size_t value_size);
 
+/// Shortest decimal text that reads back as exactly the same double.
+std::string format_double(double x);
+
 /// Parses a floating-point number; throws InputError(path, what + ...) otherwise.
 double parse_double(const std::string& path, const std::string& text, const std::string& what);
 int64_t parse_int(const std::string& path, const std::string& text, const std::string& what);

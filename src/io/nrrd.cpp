@@ -157,19 +157,11 @@ void parse_text(const std::string& path, const std::string& text, ScalarVolume& 
                                std::to_string(n));
 }
 
+// NRRD accepts voxpress's integer type names as they are.
 std::string nrrd_type_name(ScalarType t) {
-  switch (t) {
-    case ScalarType::u8: return "uint8";
-    case ScalarType::i8: return "int8";
-    case ScalarType::u16: return "uint16";
-    case ScalarType::i16: return "int16";
-    case ScalarType::u32: return "uint32";
-    case ScalarType::i32: return "int32";
-    case ScalarType::u64: return "uint64";
-    case ScalarType::i64: return "int64";
-    case ScalarType::f32: return "float";
-    default: return "double";
-  }
+  if (t == ScalarType::f32) return "float";
+  if (t == ScalarType::f64) return "double";
+  return scalar_name(t);
 }
 
 }  // namespace

@@ -13,11 +13,7 @@
 
 namespace voxpress::detail {
 namespace {
-std::string fmt(double x) {
-  char tmp[32];
-  auto r = std::to_chars(tmp, tmp + 32, x);
-  return std::string(tmp, r.ptr);
-}
+const auto& fmt = format_double;
 }  // namespace
 
 Mesh read_obj(const std::string& path, uint64_t max_bytes) {

@@ -330,10 +330,8 @@ void write_ply(const std::string& path, const Mesh& m, bool binary) {
     auto put = [&](const void* p, size_t n) { buf.append(static_cast<const char*>(p), n); };
     auto put_typed = [&](ScalarType t, double x) {
       if (!binary) {
-        char tmp[32];
-        auto r = std::to_chars(tmp, tmp + 32, t == ScalarType::f32 ? double(float(x)) : x);
         if (!buf.empty() && buf.back() != '\n') buf.push_back(' ');
-        buf.append(tmp, r.ptr);
+        buf += format_double(t == ScalarType::f32 ? double(float(x)) : x);
         return;
       }
       switch (t) {

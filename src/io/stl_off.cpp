@@ -17,13 +17,7 @@
 namespace voxpress::detail {
 namespace {
 
-std::string fmt_double(double x) {
-  char tmp[32];
-  auto r = std::to_chars(tmp, tmp + 32, x);
-  return std::string(tmp, r.ptr);
-}
-
-// Whitespace tokenizer over a buffer, with line tracking for OFF.
+// Whitespace tokenizer over a buffer; '#' starts a comment.
 class Tokens {
  public:
   Tokens(const std::string& path, const char* p, const char* end) : path_(path), p_(p), end_(end) {}
@@ -231,8 +225,8 @@ Mesh read_off(const std::string& path, uint64_t max_bytes) {
     for (auto& i : poly) {
       const double x = lt.number("vertex index");
       if (x < 0 || x >= nv || x != std::floor(x))
-        throw InputError(path, "face " + std::to_string(f) + " uses vertex " + fmt_double(x) + " but there are " +
-                                   fmt_double(nv) + " vertices");
+        throw InputError(path, "face " + std::to_string(f) + " uses vertex " + format_double(x) + " but there are " +
+                                   format_double(nv) + " vertices");
       i = uint32_t(x);
     }
     for (size_t q = 1; q + 1 < poly.size(); ++q) m.triangles.push_back({poly[0], poly[q], poly[q + 1]});
@@ -246,7 +240,7 @@ void write_off(const std::string& path, const Mesh& m) {
   write_stream_atomically(path, [&](std::ostream& out) {
     std::string buf = "OFF\n" + std::to_string(m.positions.size()) + " " + std::to_string(m.triangles.size()) + " 0\n";
     for (const Vec3& p : m.positions) {
-      buf += fmt_double(p.x()) + " " + fmt_double(p.y()) + " " + fmt_double(p.z()) + "\n";
+      buf += format_double(p.x()) + " " + format_double(p.y()) + " " + format_double(p.z()) + "\n";
       if (buf.size() > (1 << 20)) {
         out << buf;
         buf.clear();

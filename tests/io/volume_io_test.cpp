@@ -1,5 +1,6 @@
 // Volume readers and writers: round trips, hand-written variants, bad input
 // and the real files of ../shared/data.
+#include <nifti2_io.h>
 #include <zlib.h>
 
 #include <fstream>
@@ -99,6 +100,47 @@ TEST(VolumeIO, RoundTripEveryWriterAndType) {
       }
     }
   }
+}
+
+TEST(VolumeIO, ReadsNifti2WithSformAndScaling) {
+  // Written at the format level (nifti_2_header), so the test does not depend
+  // on any writer: 540-byte header, 4 extension bytes, int16 data.
+  test::TempDir tmp;
+  nifti_2_header h;
+  std::memset(&h, 0, sizeof h);
+  static_assert(sizeof(nifti_2_header) == 540);
+  h.sizeof_hdr = 540;
+  std::memcpy(h.magic, "n+2\0\r\n\032\n", 8);
+  h.datatype = DT_INT16;
+  h.bitpix = 16;
+  const int64_t dims[8] = {3, 4, 3, 2, 1, 1, 1, 1};
+  std::copy(dims, dims + 8, h.dim);
+  for (double& p : h.pixdim) p = 1;
+  h.vox_offset = 544;
+  h.scl_slope = 0.5;
+  h.scl_inter = 1;
+  h.sform_code = NIFTI_XFORM_SCANNER_ANAT;
+  const double rows[3][4] = {{0, -2, 0, 10}, {1.5, 0, 0, -20}, {0, 0, 3, 5}};
+  std::copy(rows[0], rows[0] + 4, h.srow_x);
+  std::copy(rows[1], rows[1] + 4, h.srow_y);
+  std::copy(rows[2], rows[2] + 4, h.srow_z);
+  std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
+  bytes.append(4, '\0');
+  for (int16_t i = 0; i < 24; ++i) bytes.append(reinterpret_cast<const char*>(&i), 2);
+  write_bytes(tmp.path("v2.nii"), bytes);
+  write_bytes(tmp.path("v2.nii.gz"), gzip(bytes));
+  for (const std::string name : {"v2.nii", "v2.nii.gz"}) {
+    SCOPED_TRACE(name);
+    const ScalarVolume v = read_volume(tmp.path(name));
+    EXPECT_EQ(v.lattice.dims, (std::array<int64_t, 3>{4, 3, 2}));
+    EXPECT_EQ(v.lattice.space, Space::RAS);
+    EXPECT_LT((v.lattice.to_physical(Vec3(1, 2, 1)) - Vec3(10 - 4, -20 + 1.5, 5 + 3)).norm(), 1e-9);
+    EXPECT_EQ(v.type, ScalarType::f32);  // scaled
+    EXPECT_EQ(v.value(7), 0.5 * 7 + 1);
+  }
+  // Truncated NIfTI-2 payload.
+  write_bytes(tmp.path("short2.nii"), bytes.substr(0, bytes.size() - 10));
+  expect_input_error([&] { read_volume(tmp.path("short2.nii")); }, "short2.nii", "truncated");
 }
 
 TEST(VolumeIO, NrrdVariants) {
