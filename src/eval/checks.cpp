@@ -11,13 +11,9 @@
 //   5. self-intersections: BVH over face boxes, exact triangle-pair tests that
 //      ignore what adjacent faces legitimately share (predicates.h).
 //
-// check_classification: the mesh is mapped to index space; each lattice row
-// (j, k) is a ray along +i, symbolically perturbed to (j + e, k + e^2) so it
-// never hits a vertex or edge exactly. A triangle crossed by the ray adds +1
-// to the winding number of the samples after it when it faces -i (entering),
-// -1 otherwise. Which samples lie after the crossing is decided exactly with
-// orient3d against the triangle's plane; a sample on the plane and inside the
-// triangle lies on the surface and is a violation.
+// check_classification: the mesh is mapped to index space and every lattice
+// row is classified exactly by RowRays (row_rays.h); a sample lying exactly on
+// the surface is a violation.
 #include "voxpress/eval/checks.h"
 
 #include <tbb/parallel_for.h>
@@ -33,6 +29,7 @@
 
 #include "../core/bvh.h"
 #include "../core/predicates.h"
+#include "row_rays.h"
 
 namespace voxpress {
 namespace {
@@ -254,164 +251,39 @@ MeshCheck check_mesh(const Mesh& mesh, const MeshCheckOptions& options) {
 }
 
 // ---------------------------------------------------------------------------
-namespace {
-
-struct Crossing {
-  int64_t before;  // last sample index strictly before the crossing (may be -2)
-  int delta;       // winding change for samples after it
-};
-
-// Perturbed 2D orientation of q = (qy + e, qz + e^2) against edge a -> b (yz).
-int perturbed_orient(const Vec3& a, const Vec3& b, double qy, double qz) {
-  const int s = detail::orient2d(a.y(), a.z(), b.y(), b.z(), qy, qz);
-  if (s != 0) return s;
-  if (a.z() != b.z()) return a.z() > b.z() ? 1 : -1;  // d/d(qy) = a.z - b.z
-  if (a.y() != b.y()) return b.y() > a.y() ? 1 : -1;  // d/d(qz) = b.y - a.y
-  return 0;
-}
-
-// Does the closed yz-projection of triangle (a, b, c) contain (qy, qz)?
-bool touches_row(const Vec3& a, const Vec3& b, const Vec3& c, int sigma, double qy, double qz) {
-  const int s1 = detail::orient2d(a.y(), a.z(), b.y(), b.z(), qy, qz);
-  const int s2 = detail::orient2d(b.y(), b.z(), c.y(), c.z(), qy, qz);
-  const int s3 = detail::orient2d(c.y(), c.z(), a.y(), a.z(), qy, qz);
-  if (sigma != 0) return s1 * sigma >= 0 && s2 * sigma >= 0 && s3 * sigma >= 0;
-  // Degenerate projection (a segment or a point): (qy, qz) must be collinear
-  // with it and within its extent.
-  if (s1 != 0 || s2 != 0 || s3 != 0) return false;
-  const double ylo = std::min({a.y(), b.y(), c.y()}), yhi = std::max({a.y(), b.y(), c.y()});
-  const double zlo = std::min({a.z(), b.z(), c.z()}), zhi = std::max({a.z(), b.z(), c.z()});
-  return ylo <= qy && qy <= yhi && zlo <= qz && qz <= zhi;
-}
-
-}  // namespace
-
 ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& volume,
                                           const ClassificationOptions& options) {
   ClassificationReport rep;
   const Lattice& L = volume.lattice;
-  const int64_t nx = L.dims[0], ny = L.dims[1], nz = L.dims[2];
   const int64_t pad = options.include_padding ? 1 : 0;
-  const int64_t i0 = -pad, i1 = nx - 1 + pad;  // sample range along each row
-  const int64_t j0 = -pad, j1 = ny - 1 + pad, k0 = -pad, k1 = nz - 1 + pad;
-  const int64_t rows_y = j1 - j0 + 1, rows_z = k1 - k0 + 1;
-
-  // Mesh in index space.
-  const bool mirrored = L.flips_orientation();
+  const std::array<int64_t, 3> lo{-pad, -pad, -pad};
+  const std::array<int64_t, 3> hi{L.dims[0] - 1 + pad, L.dims[1] - 1 + pad, L.dims[2] - 1 + pad};
   const Mat3 inv = L.index_to_physical_matrix().inverse();
   std::vector<Vec3> V(mesh.positions.size());
   for (size_t v = 0; v < V.size(); ++v) V[v] = inv * (mesh.positions[v] - L.origin);
-
-  // Bin (triangle, row) hits: count, prefix-sum, fill.
-  struct Hit {
-    uint32_t tri;
-    int sigma;      // sign of the yz-projected area (= sign of the normal's x); 0: parallel to the rays
-    bool crossing;  // the perturbed ray crosses it (else it only touches the row line)
-  };
-  auto row_of = [&](int64_t j, int64_t k) { return size_t((k - k0) * rows_y + (j - j0)); };
-  std::vector<uint32_t> start(size_t(rows_y * rows_z) + 1, 0);
-  auto for_each_hit = [&](auto&& emit) {
-    for (size_t f = 0; f < mesh.triangles.size(); ++f) {
-      const Triangle& t = mesh.triangles[f];
-      const Vec3 &a = V[t[0]], &b = V[t[1]], &c = V[t[2]];
-      const int sigma = detail::orient2d(a.y(), a.z(), b.y(), b.z(), c.y(), c.z());
-      const double ylo = std::min({a.y(), b.y(), c.y()}), yhi = std::max({a.y(), b.y(), c.y()});
-      const double zlo = std::min({a.z(), b.z(), c.z()}), zhi = std::max({a.z(), b.z(), c.z()});
-      const int64_t ja = std::max<int64_t>(j0, int64_t(std::ceil(ylo))), jb = std::min<int64_t>(j1, int64_t(std::floor(yhi)));
-      const int64_t ka = std::max<int64_t>(k0, int64_t(std::ceil(zlo))), kb = std::min<int64_t>(k1, int64_t(std::floor(zhi)));
-      for (int64_t k = ka; k <= kb; ++k)
-        for (int64_t j = ja; j <= jb; ++j) {
-          const double qy = double(j), qz = double(k);
-          if (sigma != 0) {
-            const int s1 = perturbed_orient(a, b, qy, qz), s2 = perturbed_orient(b, c, qy, qz),
-                      s3 = perturbed_orient(c, a, qy, qz);
-            if (s1 == sigma && s2 == sigma && s3 == sigma) {
-              emit(row_of(j, k), Hit{uint32_t(f), sigma, true});
-              continue;
-            }
-          }
-          // Not crossed by the perturbed ray, but the row line itself may
-          // touch the closed triangle: samples there could lie on it.
-          if (touches_row(a, b, c, sigma, qy, qz)) emit(row_of(j, k), Hit{uint32_t(f), sigma, false});
-        }
-    }
-  };
-  for_each_hit([&](size_t row, Hit) { ++start[row + 1]; });
-  for (size_t r = 1; r < start.size(); ++r) start[r] += start[r - 1];
-  std::vector<Hit> hits(start.back());
-  {
-    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-    for_each_hit([&](size_t row, Hit h) { hits[fill[row]++] = h; });
-  }
+  const detail::RowRays rays(std::move(V), mesh.triangles, lo, hi, L.flips_orientation());
 
   std::atomic<uint64_t> in_out{0}, out_in{0}, on{0};
   std::mutex m;
   std::vector<std::array<int64_t, 3>> examples;
-  ProgressCounter progress(options.progress, "classification", uint64_t(rows_z));
-  tbb::parallel_for(k0, k1 + 1, [&](int64_t k) {
-    std::vector<Crossing> cross;
-    std::vector<int> winding(size_t(i1 - i0 + 2));
-    std::vector<int> parity(size_t(i1 - i0 + 2));
+  ProgressCounter progress(options.progress, "classification", uint64_t(hi[2] - lo[2] + 1));
+  tbb::parallel_for(lo[2], hi[2] + 1, [&](int64_t k) {
+    std::vector<int> winding;
+    std::vector<uint8_t> odd;
+    std::vector<int64_t> on_surface;
     uint64_t local[3] = {0, 0, 0};
     std::vector<std::array<int64_t, 3>> local_ex;
-    for (int64_t j = j0; j <= j1; ++j) {
-      const size_t row = row_of(j, k);
-      cross.clear();
-      std::vector<int64_t> on_samples;
-      for (uint32_t h = start[row]; h < start[row + 1]; ++h) {
-        const Triangle& t = mesh.triangles[hits[h].tri];
-        const Vec3 &a = V[t[0]], &b = V[t[1]], &c = V[t[2]];
-        const int sigma = hits[h].sigma;
-        if (!hits[h].crossing) {
-          // Touching only: report the samples lying exactly on the triangle.
-          auto lies_on = [&](int64_t i) {
-            const Vec3 p{double(i), double(j), double(k)};
-            return detail::segment_intersects_triangle(p, p, a, b, c);
-          };
-          double lo = std::min({a.x(), b.x(), c.x()}), hi = std::max({a.x(), b.x(), c.x()});
-          if (sigma != 0) {  // a single point of the row line is on the plane
-            const Vec3 n = (b - a).cross(c - a);
-            const double xc = a.x() - (n.y() * (double(j) - a.y()) + n.z() * (double(k) - a.z())) / n.x();
-            if (std::isfinite(xc)) lo = hi = xc;
-          }
-          const int64_t from = std::max<int64_t>(i0, int64_t(std::floor(lo)) - 1);
-          const int64_t to = std::min<int64_t>(i1, int64_t(std::ceil(hi)) + 1);
-          for (int64_t i = from; i <= to; ++i)
-            if (lies_on(i)) on_samples.push_back(i);
-          continue;
-        }
-        // s(i) < 0: sample i before the crossing; > 0 after; 0 on the triangle.
-        auto s = [&](int64_t i) { return detail::orient3d(a, b, c, Vec3(double(i), double(j), double(k))) * sigma; };
-        const Vec3 n = (b - a).cross(c - a);
-        double xc = a.x() - (n.y() * (double(j) - a.y()) + n.z() * (double(k) - a.z())) / n.x();
-        if (!std::isfinite(xc)) xc = 0.5 * double(i0 + i1);
-        int64_t before = std::clamp<int64_t>(int64_t(std::floor(xc)), i0 - 1, i1);
-        while (before + 1 <= i1 && s(before + 1) < 0) ++before;
-        while (before >= i0 && s(before) >= 0) --before;
-        if (before + 1 <= i1 && s(before + 1) == 0) on_samples.push_back(before + 1);
-        // Entering the solid (outward normal towards -i) raises the winding
-        // number; mapping to index space mirrors orientation when the lattice does.
-        cross.push_back({before, (sigma < 0) != mirrored ? 1 : -1});
-      }
-      std::fill(winding.begin(), winding.end(), 0);
-      std::fill(parity.begin(), parity.end(), 0);
-      for (const Crossing& c : cross) {
-        winding[size_t(c.before + 1 - i0)] += c.delta;
-        parity[size_t(c.before + 1 - i0)] ^= 1;
-      }
-      std::sort(on_samples.begin(), on_samples.end());
-      on_samples.erase(std::unique(on_samples.begin(), on_samples.end()), on_samples.end());
-      auto next_on = on_samples.begin();
-      int w = 0, par = 0;
-      for (int64_t i = i0; i <= i1; ++i) {
-        w += winding[size_t(i - i0)];
-        par ^= parity[size_t(i - i0)];
+    for (int64_t j = lo[1]; j <= hi[1]; ++j) {
+      rays.classify(j, k, winding, odd, on_surface);
+      auto next_on = on_surface.begin();
+      for (int64_t i = lo[0]; i <= hi[0]; ++i) {
         int kind = -1;  // 0: inside found outside, 1: outside found inside, 2: on the surface
-        if (next_on != on_samples.end() && *next_on == i) {
+        if (next_on != on_surface.end() && *next_on == i) {
           ++next_on;
           kind = 2;
         } else {
-          const bool inside = options.rule == ClassificationOptions::Rule::winding ? w > 0 : par != 0;
+          const size_t x = size_t(i - lo[0]);
+          const bool inside = options.rule == ClassificationOptions::Rule::winding ? winding[x] > 0 : odd[x] != 0;
           const bool expected = volume.at(i, j, k);
           if (inside != expected) kind = expected ? 0 : 1;
         }
@@ -430,7 +302,7 @@ ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& 
     }
     progress.add(1);
   });
-  rep.samples = uint64_t(i1 - i0 + 1) * uint64_t(rows_y) * uint64_t(rows_z);
+  rep.samples = uint64_t(hi[0] - lo[0] + 1) * uint64_t(hi[1] - lo[1] + 1) * uint64_t(hi[2] - lo[2] + 1);
   rep.inside_found_outside = in_out;
   rep.outside_found_inside = out_in;
   rep.on_surface = on;
