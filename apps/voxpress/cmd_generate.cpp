@@ -1,5 +1,6 @@
 // voxpress generate SHAPE --res N [--rotate random:SEED | AX,AY,AZ] [--spacing SX,SY,SZ] -o OUT
 #include "common.h"
+#include "voxpress/eval/truth.h"
 
 namespace voxpress::cli {
 namespace {
@@ -23,12 +24,7 @@ void run_generate(const GenerateCmd& c, const Global& g) {
   const GeneratedShape s = generate_shape(kind, o);
   ScalarVolume v = to_scalar(s.volume);
   v.metadata[kShapeKey] = shape_name(kind);
-  std::ostringstream t;
-  t.precision(17);
-  for (int r = 0; r < 3; ++r)
-    for (int col = 0; col < 3; ++col) t << s.linear(r, col) << ' ';
-  t << s.translation.x() << ' ' << s.translation.y() << ' ' << s.translation.z();
-  v.metadata[kModelToPhysicalKey] = t.str();
+  v.metadata[kModelToPhysicalKey] = format_transform(s.linear, s.translation);
   v.metadata["voxpress_rotate"] = c.rotate;
   write_volume(c.output, v);
   if (!c.stats_json.empty()) {

@@ -85,5 +85,7 @@ void register_info(CLI::App& app, Global& g);
 void register_extract(CLI::App& app, Global& g);
 void register_generate(CLI::App& app, Global& g);
 void register_check(CLI::App& app, Global& g);
+void register_voxelize(CLI::App& app, Global& g);
+void register_eval(CLI::App& app, Global& g);
 
 }  // namespace voxpress::cli

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   cli::register_extract(app, g);
   cli::register_generate(app, g);
   cli::register_check(app, g);
+  cli::register_voxelize(app, g);
+  cli::register_eval(app, g);
 
   try {
     app.parse(argc, argv);

@@ -34,20 +34,73 @@ Bvh::Bvh(std::span<const Aabb> boxes) : boxes_(boxes.begin(), boxes.end()) {
       cbox.grow(centre[order_[i]]);
     }
     nodes_[index].box = box;
-    const Vec3 ext = cbox.hi - cbox.lo;
-    int axis = 0;
-    if (ext[1] > ext[axis]) axis = 1;
-    if (ext[2] > ext[axis]) axis = 2;
-    if (job.count <= kLeafSize || !(ext[axis] > 0)) {
+    if (job.count <= kLeafSize) {
       nodes_[index].first = job.first;
       nodes_[index].count = job.count;
       continue;
     }
-    const uint32_t half = job.count / 2;
+    // Binned surface-area heuristic: 16 bins per axis over the centroid
+    // bounds; cost = area(L) * |L| + area(R) * |R|. It keeps large faces
+    // (slivers) away from small ones, which median splits mix into leaves
+    // whose boxes then swallow every nearby query.
+    constexpr int kBins = 16;
+    auto half_area = [](const Aabb& b) {
+      const Vec3 e = b.hi - b.lo;
+      return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    };
+    double best_cost = INFINITY;
+    int best_axis = -1, best_bin = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double lo = cbox.lo[axis], ext = cbox.hi[axis] - lo;
+      if (!(ext > 0)) continue;
+      Aabb bin_box[kBins];
+      uint32_t bin_count[kBins] = {};
+      for (uint32_t i = job.first; i < job.first + job.count; ++i) {
+        const int b = std::min(kBins - 1, int(kBins * (centre[order_[i]][axis] - lo) / ext));
+        bin_box[b].grow(boxes_[order_[i]]);
+        ++bin_count[b];
+      }
+      double right_area[kBins];
+      uint32_t right_count[kBins];
+      Aabb acc;
+      uint32_t count = 0;
+      for (int b = kBins - 1; b > 0; --b) {
+        if (bin_count[b]) acc.grow(bin_box[b]);
+        count += bin_count[b];
+        right_area[b] = count ? half_area(acc) : 0;
+        right_count[b] = count;
+      }
+      acc = Aabb();
+      count = 0;
+      for (int b = 0; b < kBins - 1; ++b) {
+        if (bin_count[b]) acc.grow(bin_box[b]);
+        count += bin_count[b];
+        if (count == 0 || right_count[b + 1] == 0) continue;
+        const double cost = half_area(acc) * count + right_area[b + 1] * right_count[b + 1];
+        if (cost < best_cost) {
+          best_cost = cost;
+          best_axis = axis;
+          best_bin = b;
+        }
+      }
+    }
+    if (best_axis < 0) {  // all centroids coincide: split in the middle of the order
+      nodes_[index].first = job.first;
+      nodes_[index].count = job.count;
+      if (job.count > 4 * kLeafSize) {
+        nodes_[index].count = 0;
+        const uint32_t half = job.count / 2;
+        jobs.push_back({index, true, job.first + half, job.count - half});
+        jobs.push_back({index, false, job.first, half});
+      }
+      continue;
+    }
+    const double lo = cbox.lo[best_axis], ext = cbox.hi[best_axis] - lo;
     auto begin = order_.begin() + job.first;
-    std::nth_element(begin, begin + half, begin + job.count, [&](uint32_t a, uint32_t b) {
-      return centre[a][axis] < centre[b][axis] || (centre[a][axis] == centre[b][axis] && a < b);
+    auto mid_it = std::stable_partition(begin, begin + job.count, [&](uint32_t p) {
+      return std::min(kBins - 1, int(kBins * (centre[p][best_axis] - lo) / ext)) <= best_bin;
     });
+    const uint32_t half = uint32_t(mid_it - begin);
     jobs.push_back({index, true, job.first + half, job.count - half});
     jobs.push_back({index, false, job.first, half});
   }

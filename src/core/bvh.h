@@ -1,8 +1,8 @@
 // A compact bounding-volume hierarchy over axis-aligned boxes (private).
 //
-// Built top-down by median split along the longest axis of the centroid
-// bounds, iteratively (no recursion whose depth grows with the data), leaves
-// of at most kLeafSize primitives. Nodes are stored depth-first; the left
+// Built top-down with the binned surface-area heuristic (16 bins per axis),
+// iteratively (no recursion whose depth grows with the data), leaves of at
+// most kLeafSize primitives (more only when their centroids coincide). Nodes are stored depth-first; the left
 // child of an inner node is the next node, `right` names the other. Used for
 // self-intersection tests and, later, closest-point queries.
 #pragma once

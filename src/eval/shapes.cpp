@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "voxpress/core/error.h"
+#include "voxpress/eval/voxelize.h"
 
 namespace voxpress {
 namespace {
@@ -15,39 +16,6 @@ namespace {
 constexpr double kTorusMajor = 1.0, kTorusMinor = 0.4;
 const Vec3 kBoxHalf(1.0, 0.75, 0.5);
 constexpr double kCylRadius = 0.6, kCylHalf = 1.0;
-
-// CAD part dimensions (model units).
-constexpr double kPlateX = 1.0, kPlateY = 0.7, kPlateZ = 0.25, kPlateRound = 0.2;
-constexpr double kChamfer = 0.15;                 // leg of the 45-degree chamfer on the +x top edge
-constexpr double kBossX = 0.3, kBossY = 0.0, kBossR = 0.35, kBossTop = 0.75;
-constexpr double kFillet = 0.1;                   // concave fillet at the boss base
-constexpr double kHoleX = -0.5, kHoleY = 0.1, kHoleR = 0.18;
-
-bool cad_contains(const Vec3& m) {
-  const double x = m.x(), y = m.y(), z = m.z();
-  // Through hole first: nothing inside it.
-  if ((x - kHoleX) * (x - kHoleX) + (y - kHoleY) * (y - kHoleY) < kHoleR * kHoleR) return false;
-  const double rb = std::hypot(x - kBossX, y - kBossY);
-  // Boss.
-  if (rb <= kBossR && z >= kPlateZ - 1e-12 && z <= kBossTop) return true;
-  // Concave fillet: the ring kBossR <= r <= kBossR + f, plate top <= z <= top + f,
-  // minus the torus tube centred at (kBossR + f, kPlateZ + f) of radius f.
-  if (rb >= kBossR && rb <= kBossR + kFillet && z >= kPlateZ && z <= kPlateZ + kFillet) {
-    const double dr = rb - (kBossR + kFillet), dz = z - (kPlateZ + kFillet);
-    if (dr * dr + dz * dz >= kFillet * kFillet) return true;
-  }
-  // Plate: rounded rectangle in xy, |z| <= kPlateZ, chamfer x + z <= kPlateX + kPlateZ - kChamfer.
-  if (std::abs(z) > kPlateZ) return false;
-  if (x + z > kPlateX + kPlateZ - kChamfer) return false;
-  const double ax = std::abs(x), ay = std::abs(y);
-  if (ax > kPlateX || ay > kPlateY) return false;
-  const double cx = kPlateX - kPlateRound, cy = kPlateY - kPlateRound;
-  if (ax > cx && ay > cy) {
-    const double dx = ax - cx, dy = ay - cy;
-    return dx * dx + dy * dy <= kPlateRound * kPlateRound;
-  }
-  return true;
-}
 
 uint64_t splitmix(uint64_t& s) {
   uint64_t z = (s += 0x9e3779b97f4a7c15ull);
@@ -90,7 +58,7 @@ bool shape_contains(ShapeKind kind, const Vec3& m) {
     case ShapeKind::box:
       return std::abs(m.x()) <= kBoxHalf.x() && std::abs(m.y()) <= kBoxHalf.y() && std::abs(m.z()) <= kBoxHalf.z();
     case ShapeKind::cylinder: return m.x() * m.x() + m.y() * m.y() <= kCylRadius * kCylRadius && std::abs(m.z()) <= kCylHalf;
-    default: return cad_contains(m);
+    default: return mesh_contains(cad_part_mesh(), m);
   }
 }
 
@@ -102,9 +70,9 @@ double shape_support(ShapeKind kind, const Vec3& d) {
     case ShapeKind::box: return kBoxHalf.cwiseProduct(d.cwiseAbs()).sum();
     case ShapeKind::cylinder: return kCylRadius * dxy + kCylHalf * std::abs(d.z());
     default: {
-      // Bounding box x in [-1, 1], y in [-0.7, 0.7], z in [-0.25, 0.75] (conservative).
-      const double zc = 0.5 * (kBossTop - kPlateZ), zh = 0.5 * (kBossTop + kPlateZ);
-      return kPlateX * std::abs(d.x()) + kPlateY * std::abs(d.y()) + zc * d.z() + zh * std::abs(d.z());
+      double best = -INFINITY;  // exact for the polyhedral B-rep
+      for (const Vec3& p : cad_part_mesh().positions) best = std::max(best, p.dot(d));
+      return best;
     }
   }
 }
@@ -117,34 +85,20 @@ double shape_volume(ShapeKind kind) {
     case ShapeKind::box: return 8 * kBoxHalf.prod();
     case ShapeKind::cylinder: return pi * kCylRadius * kCylRadius * 2 * kCylHalf;
     default: {
-      // Plate (rounded rectangle) - chamfer + boss + fillet ring - hole; the
-      // pieces do not overlap otherwise (see the dimensions above).
-      const double plate = (4 * kPlateX * kPlateY - (4 - pi) * kPlateRound * kPlateRound) * 2 * kPlateZ;
-      // Chamfer: at height y the plate reaches x = X(y) (rounded corners) and
-      // the cut removes the triangle of area 0.5 * max(0, X - (kPlateX - kChamfer))^2
-      // from the xz cross-section; integrate over y (Simpson, smooth enough).
-      auto xmax = [](double y) {
-        const double dy = std::abs(y) - (kPlateY - kPlateRound);
-        return dy <= 0 ? kPlateX : kPlateX - kPlateRound + std::sqrt(std::max(0.0, kPlateRound * kPlateRound - dy * dy));
-      };
-      auto section = [&](double y) {
-        const double d = std::max(0.0, xmax(y) - (kPlateX - kChamfer));
-        return 0.5 * d * d;
-      };
-      const int n = 20000;
-      const double h = 2 * kPlateY / n;
-      double chamfer = section(-kPlateY) + section(kPlateY);
-      for (int i = 1; i < n; ++i) chamfer += (i % 2 ? 4 : 2) * section(-kPlateY + i * h);
-      chamfer *= h / 3;
-      const double boss = pi * kBossR * kBossR * (kBossTop - kPlateZ);
+      // Plate (rectangle with the two -x corners rounded) - chamfer prism +
+      // boss + fillet ring - hole; the pieces do not overlap otherwise.
+      const double plate = (2 * 2 * 0.7 - 2 * (1 - pi / 4) * 0.2 * 0.2) * 0.5;
+      const double chamfer = 0.5 * 0.15 * 0.15 * 1.4;
+      const double boss = pi * 0.35 * 0.35 * 0.5;
       // Fillet ring: revolve the region between the square [0,f]^2 and the
-      // quarter disc of radius f centred at (f, f), at radius r = kBossR + x.
-      // Area f^2 (1 - pi/4); its centroid lies f (10 - 3 pi) / (12 - 3 pi)
-      // from the boss wall (Pappus' theorem gives the volume).
-      const double a = kFillet * kFillet * (1 - pi / 4);
-      const double xc = kFillet * (10 - 3 * pi) / (12 - 3 * pi);
-      const double fillet = 2 * pi * (kBossR + xc) * a;
-      const double hole = pi * kHoleR * kHoleR * 2 * kPlateZ;
+      // quarter disc of radius f centred at (f, f) about the boss axis, at
+      // r = 0.35 + x. Area f^2 (1 - pi/4); its centroid lies
+      // f (10 - 3 pi) / (12 - 3 pi) from the boss wall (Pappus' theorem).
+      const double f = 0.1;
+      const double a = f * f * (1 - pi / 4);
+      const double xc = f * (10 - 3 * pi) / (12 - 3 * pi);
+      const double fillet = 2 * pi * (0.35 + xc) * a;
+      const double hole = pi * 0.18 * 0.18 * 0.5;
       return plate - chamfer + boss + fillet - hole;
     }
   }
@@ -192,10 +146,6 @@ Mat3 parse_rotation(const std::string& spec) {
 }
 
 GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
-  if (o.res < 8) throw UsageError("--res must be at least 8");
-  if (o.margin < 0 || o.margin > o.res / 4) throw UsageError("--margin must be between 0 and res/4");
-  for (int a = 0; a < 3; ++a)
-    if (!(o.spacing[a] > 0) || !std::isfinite(o.spacing[a])) throw UsageError("--spacing values must be > 0");
   const Mat3& R = o.rotation;
   // Extent of the rotated shape along each world axis: support in +/- e_a.
   Vec3 lo, hi;
@@ -204,40 +154,34 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
     hi[a] = shape_support(kind, d);
     lo[a] = -shape_support(kind, -d);
   }
-  const Vec3 extent = hi - lo;
-  double cells = 0;
-  for (int a = 0; a < 3; ++a) cells = std::max(cells, extent[a] / o.spacing[a]);
-  const double scale = double(o.res - 1 - 2 * o.margin) / cells;  // physical units per model unit
-  Lattice L;
-  for (int a = 0; a < 3; ++a) {
-    const double span = scale * extent[a] / o.spacing[a];
-    L.dims[size_t(a)] = std::max<int64_t>(int64_t(std::ceil(span - 1e-9)) + 1 + 2 * o.margin, 2);
-  }
-  L.spacing = o.spacing;
-  L.validate();
-  if (o.max_bytes && L.size() > o.max_bytes)
-    throw LimitError("", "a " + std::to_string(L.dims[0]) + "x" + std::to_string(L.dims[1]) + "x" +
-                             std::to_string(L.dims[2]) + " volume exceeds the memory limit");
+  const Placement place = place_on_lattice(lo, hi, R, o.res, o.spacing, o.margin, o.max_bytes);
   GeneratedShape g;
   g.kind = kind;
-  g.scale = scale;
-  g.linear = scale * R;
-  const Vec3 lattice_centre = 0.5 * (Vec3(double(L.dims[0] - 1), double(L.dims[1] - 1), double(L.dims[2] - 1)))
-                                        .cwiseProduct(o.spacing);
-  g.translation = lattice_centre - scale * 0.5 * (lo + hi);
-  g.volume.lattice = L;
+  g.scale = place.scale;
+  g.linear = place.linear;
+  g.translation = place.translation;
+  const Lattice& L = place.lattice;
+  if (kind == ShapeKind::cad_part) {
+    // The part is its mesh: classify every sample exactly against it.
+    Mesh physical;
+    for (const Vec3& p : cad_part_mesh().positions) physical.positions.push_back(g.translation + g.linear * p);
+    physical.triangles = cad_part_mesh().triangles;
+    g.volume = voxelize_on(physical, L, o.progress);
+  } else {
+    g.volume.lattice = L;
+    g.volume.inside.resize(L.size());
+    const Mat3 to_model = g.linear.inverse();
+    ProgressCounter progress(o.progress, "sampling", uint64_t(L.dims[2]));
+    tbb::parallel_for(int64_t(0), L.dims[2], [&](int64_t k) {
+      for (int64_t j = 0; j < L.dims[1]; ++j)
+        for (int64_t i = 0; i < L.dims[0]; ++i) {
+          const Vec3 p = L.to_physical(Vec3(double(i), double(j), double(k)));
+          g.volume.inside[L.linear(i, j, k)] = shape_contains(kind, to_model * (p - g.translation)) ? 1 : 0;
+        }
+      progress.add(1);
+    });
+  }
   g.volume.source = std::string("generated ") + shape_name(kind);
-  g.volume.inside.resize(L.size());
-  const Mat3 to_model = g.linear.inverse();
-  ProgressCounter progress(o.progress, "sampling", uint64_t(L.dims[2]));
-  tbb::parallel_for(int64_t(0), L.dims[2], [&](int64_t k) {
-    for (int64_t j = 0; j < L.dims[1]; ++j)
-      for (int64_t i = 0; i < L.dims[0]; ++i) {
-        const Vec3 p = L.to_physical(Vec3(double(i), double(j), double(k)));
-        g.volume.inside[L.linear(i, j, k)] = shape_contains(kind, to_model * (p - g.translation)) ? 1 : 0;
-      }
-    progress.add(1);
-  });
   return g;
 }
 

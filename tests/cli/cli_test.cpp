@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "test_util.h"
+#include "voxpress/eval/truth.h"
 
 namespace voxpress {
 namespace {
@@ -19,7 +20,7 @@ size_t count_lines(const std::string& s) {
 }
 
 TEST(Cli, HelpOnEveryCommand) {
-  for (const std::string cmd : {"", "info", "extract", "generate", "check"}) {
+  for (const std::string cmd : {"", "info", "extract", "generate", "check", "voxelize", "eval"}) {
     std::string out;
     EXPECT_EQ(run_cli(cmd + " --help", &out), 0) << cmd;
     EXPECT_NE(out.find("Usage"), std::string::npos) << cmd;
@@ -171,6 +172,53 @@ TEST(Cli, BadInputsFailCleanly) {
   EXPECT_EQ(run_cli("extract " + tmp.path("s.nrrd") + " -o " + tmp.path("out.xyz"), &out), 1);
   EXPECT_NE(out.find("out.xyz"), std::string::npos);
   EXPECT_FALSE(fs::exists(tmp.path("out.ply")));
+}
+
+TEST(Cli, VoxelizeExtractEvalPipeline) {
+  test::TempDir tmp;
+  write_mesh(tmp.path("part.off"), cad_part_mesh());
+  std::string out;
+  ASSERT_EQ(run_cli("-q voxelize " + tmp.path("part.off") + " --res 64 --rotate random:2 -o " + tmp.path("v.nrrd"), &out),
+            0)
+      << out;
+  const ScalarVolume v = read_volume(tmp.path("v.nrrd"));
+  EXPECT_TRUE(v.metadata.count(kTruthMeshKey));
+  EXPECT_TRUE(v.metadata.count(kModelToPhysicalKey));
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("v.nrrd") + " -o " + tmp.path("mid.ply"), &out), 0) << out;
+  // The truth comes from the volume's metadata (the model file and its placement).
+  ASSERT_EQ(run_cli("-q eval " + tmp.path("mid.ply") + " --volume " + tmp.path("v.nrrd") + " --samples 20000 --json " +
+                        tmp.path("e.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("stick error RMS"), std::string::npos);
+  const auto e = nlohmann::json::parse(std::ifstream(tmp.path("e.json")));
+  EXPECT_GT(e["voxels"]["stick_rms"].get<double>(), 0.27);
+  EXPECT_LT(e["voxels"]["stick_rms"].get<double>(), 0.30);
+  EXPECT_EQ(e["classification_violations"], 0);
+  EXPECT_EQ(e["mesh_ok"], true);
+  EXPECT_GT(e["true_sharp_edge_segments"].get<int>(), 0);
+  // Generated shapes: the analytic truth, named or implied.
+  ASSERT_EQ(run_cli("-q generate box --res 48 --rotate random:4 -o " + tmp.path("b.nrrd"), &out), 0);
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("b.nrrd") + " -o " + tmp.path("b.ply"), &out), 0);
+  ASSERT_EQ(run_cli("-q eval " + tmp.path("b.ply") + " --volume " + tmp.path("b.nrrd") + " --truth box --samples 20000 "
+                    "--json " + tmp.path("b.json"), &out),
+            0)
+      << out;
+  EXPECT_NE(nlohmann::json::parse(std::ifstream(tmp.path("b.json")))["truth"].get<std::string>().find("box"),
+            std::string::npos);
+  // Errors: an open model, a truth nobody can place, a missing result.
+  Mesh open = cad_part_mesh();
+  open.triangles.resize(open.triangles.size() - 2);
+  write_mesh(tmp.path("open.stl"), open);
+  EXPECT_EQ(run_cli("-q voxelize " + tmp.path("open.stl") + " -o " + tmp.path("o.nrrd"), &out), 1);
+  EXPECT_NE(out.find("boundary edges"), std::string::npos) << out;
+  EXPECT_NE(out.find("open.stl"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(tmp.path("o.nrrd")));
+  EXPECT_EQ(run_cli("-q eval " + tmp.path("b.ply") + " --truth sphere", &out), 2);
+  EXPECT_EQ(run_cli("-q eval " + tmp.path("b.ply"), &out), 2);
+  EXPECT_EQ(run_cli("-q eval " + tmp.path("none.ply") + " --volume " + tmp.path("b.nrrd"), &out), 1);
+  EXPECT_NE(out.find("none.ply"), std::string::npos);
 }
 
 TEST(Cli, SharedLabelMapsPerLabel) {

@@ -60,16 +60,26 @@ TEST(Shapes, RotationsAreDeterministicAndUniformish) {
   EXPECT_THROW(parse_shape("teapot"), UsageError);
 }
 
+TEST(Shapes, CadPartMeshIsAValidSolidMatchingItsClosedFormVolume) {
+  const Mesh& m = cad_part_mesh();
+  const MeshCheck r = check_mesh(m);
+  EXPECT_TRUE(r.ok()) << (r.problems.empty() ? "" : r.problems[0]);
+  EXPECT_EQ(r.euler, 0);  // genus 1: the through hole
+  EXPECT_NEAR(r.signed_volume, shape_volume(ShapeKind::cad_part), 2e-5);
+}
+
 TEST(Shapes, CadPartHasTheAdvertisedFeatures) {
   // Through hole: a vertical line through its axis is empty; boss and plate are solid.
   EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(-0.5, 0.1, 0)));
   EXPECT_TRUE(shape_contains(ShapeKind::cad_part, Vec3(-0.5, 0.4, 0)));
   EXPECT_TRUE(shape_contains(ShapeKind::cad_part, Vec3(0.3, 0, 0.7)));
   EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(0.3, 0, 0.8)));
-  // Chamfer on the +x top edge, rounded vertical corners.
+  // Chamfer along the whole +x top edge; rounded -x vertical corners, sharp +x ones.
   EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(0.99, 0, 0.24)));
+  EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(0.99, 0.69, 0.24)));
   EXPECT_TRUE(shape_contains(ShapeKind::cad_part, Vec3(0.99, 0, -0.24)));
-  EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(0.99, 0.69, 0)));
+  EXPECT_TRUE(shape_contains(ShapeKind::cad_part, Vec3(0.99, 0.69, 0)));
+  EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(-0.99, 0.69, 0)));
   // Concave fillet at the boss base.
   EXPECT_TRUE(shape_contains(ShapeKind::cad_part, Vec3(0.3 + 0.36, 0, 0.26)));
   EXPECT_FALSE(shape_contains(ShapeKind::cad_part, Vec3(0.3 + 0.44, 0, 0.34)));

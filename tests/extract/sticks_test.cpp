@@ -1,6 +1,7 @@
 // Property tests of the midpoint (stick) surface over hundreds of random,
 // adversarial and generated volumes.
 #include <tbb/global_control.h>
+#include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include <map>
@@ -145,7 +146,7 @@ TEST(StickSurface, IdenticalForOneAndManyThreads) {
       arena.execute([&] { one = extract_sticks(v); });
     }
     {
-      tbb::task_arena arena(4);
+      tbb::task_arena arena(std::max(2, tbb::info::default_concurrency()));
       arena.execute([&] { many = extract_sticks(v); });
     }
     EXPECT_EQ(one.lower, many.lower);

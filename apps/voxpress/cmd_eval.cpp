@@ -1,0 +1,131 @@
+// voxpress eval RESULT [--truth SHAPE|MESH] [--volume VOL] [--json FILE]
+#include <cstdio>
+
+#include "common.h"
+#include "voxpress/eval/metrics.h"
+#include "voxpress/eval/truth.h"
+
+namespace voxpress::cli {
+namespace {
+
+struct EvalCmd {
+  std::string result, truth, volume, json;
+  InputOptions in;
+  size_t samples = 400000;
+  uint64_t seed = 1;
+  bool no_self_intersections = false;
+};
+
+nlohmann::json stats_json(const DistanceStats& s) {
+  return {{"rms", s.rms}, {"mean", s.mean}, {"max", s.max}, {"samples", s.count}};
+}
+
+void run_eval(const EvalCmd& c, const Global& g) {
+  Stopwatch clock;
+  const Mesh result = read_mesh(c.result, {g.memory_limit()});
+  std::optional<ScalarVolume> raw;
+  std::optional<BinaryVolume> vol;
+  if (!c.volume.empty()) {
+    raw = load_volume(c.volume, c.in, g);
+    vol = binarize(*raw, c.in.selection());
+  }
+  const auto truth = resolve_truth(c.truth, raw ? &*raw : nullptr);
+  EvalOptions o;
+  o.samples = c.samples;
+  o.seed = c.seed;
+  o.volume = vol ? &*vol : nullptr;
+  o.self_intersections = !c.no_self_intersections;
+  ProgressBar bar(!g.quiet);
+  o.progress = bar.get();
+  const EvalReport r = evaluate(result, *truth, o);
+
+  auto fmt = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4f", v);
+    return std::string(b);
+  };
+  const bool vox = vol.has_value();
+  std::printf("result      %s: %zu vertices, %zu faces\n", c.result.c_str(), r.vertices, r.faces);
+  std::printf("truth       %s\n", r.truth.c_str());
+  std::printf("%-34s %12s %12s\n", "", vox ? "voxels" : "", "physical");
+  auto row = [&](const char* name, std::optional<double> v_vox, double v_phys) {
+    std::printf("%-34s %12s %12s\n", name, v_vox ? fmt(*v_vox).c_str() : (vox ? "n/a" : ""), fmt(v_phys).c_str());
+  };
+  if (vox) {
+    if (r.stick_rms_vox)
+      std::printf("%-34s %12s %12s   (%zu of %zu vertices on sticks)\n", "stick error RMS (Pressing Table 2)",
+                  fmt(*r.stick_rms_vox).c_str(), fmt(*r.stick_rms).c_str(), r.stick_vertices, r.vertices);
+    else
+      std::printf("%-34s %12s %12s   (no vertex lies on a stick)\n", "stick error RMS (Pressing Table 2)", "n/a", "n/a");
+  }
+  auto v = [&](const DistanceStats& s, double DistanceStats::*f) { return vox ? std::optional<double>(s.*f) : std::nullopt; };
+  row("result -> truth RMS", v(r.result_to_truth_vox, &DistanceStats::rms), r.result_to_truth.rms);
+  row("result -> truth mean", v(r.result_to_truth_vox, &DistanceStats::mean), r.result_to_truth.mean);
+  row("result -> truth max", v(r.result_to_truth_vox, &DistanceStats::max), r.result_to_truth.max);
+  row("truth -> result RMS", v(r.truth_to_result_vox, &DistanceStats::rms), r.truth_to_result.rms);
+  row("truth -> result mean", v(r.truth_to_result_vox, &DistanceStats::mean), r.truth_to_result.mean);
+  row("truth -> result max", v(r.truth_to_result_vox, &DistanceStats::max), r.truth_to_result.max);
+  row("Hausdorff (symmetric)", r.hausdorff_vox, r.hausdorff);
+  std::printf("%-34s %12s degrees\n", "normal error (area-weighted mean)", fmt(r.normal_error_deg).c_str());
+  std::printf("%-34s %12s\n", "volume ratio result / truth", fmt(r.volume_ratio).c_str());
+  if (r.classification_violations)
+    std::printf("%-34s %12lu\n", "classification violations", (unsigned long)*r.classification_violations);
+  std::printf("%-34s %12s\n", "mesh check", r.mesh.ok() ? "OK" : r.mesh.problems[0].c_str());
+  std::printf("%-34s %12s   (%zu true sharp-edge segments)\n", "sharp edges Hausdorff", "n/a", r.true_sharp_edges);
+
+  if (!c.json.empty()) {
+    nlohmann::json j;
+    j["result"] = c.result;
+    j["truth"] = r.truth;
+    j["vertices"] = r.vertices;
+    j["faces"] = r.faces;
+    j["samples_per_direction"] = c.samples;
+    j["physical"] = {{"result_to_truth", stats_json(r.result_to_truth)},
+                     {"truth_to_result", stats_json(r.truth_to_result)},
+                     {"hausdorff", r.hausdorff}};
+    if (r.stick_rms) j["physical"]["stick_rms"] = *r.stick_rms;
+    if (vox) {
+      j["voxels"] = {{"result_to_truth", stats_json(r.result_to_truth_vox)},
+                     {"truth_to_result", stats_json(r.truth_to_result_vox)},
+                     {"hausdorff", *r.hausdorff_vox}};
+      if (r.stick_rms_vox) {
+        j["voxels"]["stick_rms"] = *r.stick_rms_vox;
+        j["voxels"]["stick_max"] = *r.stick_max_vox;
+      }
+      j["stick_vertices"] = r.stick_vertices;
+      j["classification_violations"] = *r.classification_violations;
+    }
+    j["normal_error_deg"] = r.normal_error_deg;
+    j["volume_ratio"] = r.volume_ratio;
+    j["mesh_ok"] = r.mesh.ok();
+    j["mesh_problems"] = r.mesh.problems;
+    j["true_sharp_edge_segments"] = r.true_sharp_edges;
+    j["sharp_edge_hausdorff"] = nullptr;
+    j["seconds"] = clock.seconds();
+    write_json(c.json, j);
+  }
+}
+
+}  // namespace
+
+void register_eval(CLI::App& app, Global& g) {
+  auto c = std::make_shared<EvalCmd>();
+  auto* cmd = app.add_subcommand("eval", "Measure a result mesh against the true solid (stick error, distances both "
+                                         "ways, Hausdorff, normals, volume, guarantees)");
+  cmd->add_option("result", c->result, "Result mesh (.ply .obj .stl .off)")->required();
+  cmd->add_option("--truth", c->truth, "sphere|torus|box|cylinder|cad-part, or a mesh file; default: what --volume "
+                                       "records (voxpress generate / voxelize)");
+  cmd->add_option("--volume", c->volume, "The volume the result came from: placement of the truth, stick metric, "
+                                         "voxel units, classification");
+  c->in.bind(*cmd);
+  cmd->add_option("--json", c->json, "Also write the report as JSON");
+  cmd->add_option("--samples", c->samples, "Area samples per direction")->capture_default_str();
+  cmd->add_option("--seed", c->seed, "Sampling seed")->capture_default_str();
+  cmd->add_flag("--no-self-intersections", c->no_self_intersections, "Skip the self-intersection test");
+  cmd->callback([c, &g] {
+    g.apply();
+    run_eval(*c, g);
+  });
+}
+
+}  // namespace voxpress::cli

@@ -1,0 +1,69 @@
+// voxpress/eval/metrics.h — fidelity of a result mesh against the truth.
+//
+// Reported in physical units and in voxel units (lengths measured in the
+// lattice's index space, i.e. in cells; for isotropic spacing simply
+// physical / spacing):
+//   * stick metric (Pressing, Table 2): RMS over the result's vertices that
+//     lie on sticks of the volume of |t - t_true|, t_true where the true
+//     surface crosses that stick (the crossing nearest the vertex);
+//   * result -> truth and truth -> result distances (RMS, mean, max), both
+//     sides sampled uniformly by area (the result's vertices also count for
+//     the max), and the symmetric Hausdorff distance;
+//   * area-weighted mean angle between the result's face normals and the
+//     true normal at the closest point (where that point lies on a crease,
+//     the normal of the incident true face best aligned with the result's);
+//   * volume ratio result / truth; classification violations against the
+//     volume; the check_mesh verdict;
+//   * two-sided Hausdorff between the true sharp edges and the result's
+//     labelled sharp edges (n/a until results carry sharp-edge labels).
+// Sampling is deterministic (seeded, counter-based) and parallel; the
+// numbers do not depend on the thread count.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/progress.h"
+#include "voxpress/core/volume.h"
+#include "voxpress/eval/checks.h"
+#include "voxpress/eval/truth.h"
+
+namespace voxpress {
+
+struct DistanceStats {
+  double rms = 0, mean = 0, max = 0;
+  size_t count = 0;
+};
+
+struct EvalOptions {
+  size_t samples = 400000;                ///< area samples per direction
+  uint64_t seed = 1;
+  double sharp_angle_deg = 30;            ///< dihedral angle above which a true edge is sharp
+  const BinaryVolume* volume = nullptr;   ///< enables the stick metric, voxel units and classification
+  bool self_intersections = true;         ///< check_mesh's expensive part
+  Progress* progress = nullptr;
+};
+
+struct EvalReport {
+  size_t vertices = 0, faces = 0;
+  // Stick metric (needs the volume): vertices found on sticks and the RMS error.
+  size_t stick_vertices = 0;
+  std::optional<double> stick_rms_vox, stick_rms, stick_max_vox;
+  // Distances in physical units and in voxel units.
+  DistanceStats result_to_truth, truth_to_result, result_to_truth_vox, truth_to_result_vox;
+  double hausdorff = 0;
+  std::optional<double> hausdorff_vox;
+  double normal_error_deg = 0;  ///< area-weighted mean angle
+  double volume_ratio = 0;
+  std::optional<uint64_t> classification_violations;
+  MeshCheck mesh;
+  size_t true_sharp_edges = 0;             ///< segments of the truth's sharp curves
+  std::optional<double> sharp_edge_hausdorff;  ///< n/a until results carry sharp-edge labels
+  std::string truth;
+};
+
+EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& options = {});
+
+}  // namespace voxpress

@@ -1,0 +1,391 @@
+// Truth implementations: exact analytic shapes and BVH-backed meshes.
+#include "voxpress/eval/truth.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include "mesh_query.h"
+#include "voxpress/core/error.h"
+#include "voxpress/eval/voxelize.h"
+#include "voxpress/io/mesh_io.h"
+
+namespace voxpress {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kTorusR = 1.0, kTorusr = 0.4;
+const Vec3 kBoxHalf(1.0, 0.75, 0.5);
+constexpr double kCylR = 0.6, kCylH = 1.0;
+
+// ------------------------------------------------------------- analytic
+class AnalyticTruth final : public Truth {
+ public:
+  AnalyticTruth(ShapeKind kind, const Mat3& linear, const Vec3& translation)
+      : kind_(kind), A_(linear), t_(translation), Ainv_(linear.inverse()), N_(linear.inverse().transpose()),
+        scale_(std::cbrt(std::abs(linear.determinant()))) {}
+
+  std::string describe() const override { return std::string(shape_name(kind_)) + " (analytic)"; }
+
+  SurfacePoint closest(const Vec3& p, const Vec3* normal_hint) const override {
+    const Vec3 m = Ainv_ * (p - t_);
+    // Normals map with N = A^-T, so a physical hint maps back with A^T.
+    const Vec3 hint = normal_hint ? Vec3(A_.transpose() * *normal_hint) : Vec3::Zero();
+    Vec3 q, n;
+    closest_model(m, hint, q, n);
+    return {t_ + A_ * q, (N_ * n).normalized()};
+  }
+
+  bool contains(const Vec3& p) const override { return shape_contains(kind_, Ainv_ * (p - t_)); }
+
+  double crossing(const Vec3& a, const Vec3& b, double near) const override {
+    // Bisection on the exact inside test; sticks cross the smooth analytic
+    // surfaces at most a few times, so search the bracket nearest `near`.
+    const int n = 64;
+    double best = NAN;
+    bool prev = contains(a);
+    for (int i = 1; i <= n; ++i) {
+      const double s1 = double(i) / n, s0 = double(i - 1) / n;
+      const bool cur = contains(a + s1 * (b - a));
+      if (cur != prev) {
+        double lo = s0, hi = s1;
+        const bool lo_in = prev;
+        for (int it = 0; it < 60; ++it) {
+          const double mid = 0.5 * (lo + hi);
+          (contains(a + mid * (b - a)) == lo_in ? lo : hi) = mid;
+        }
+        const double s = 0.5 * (lo + hi);
+        if (std::isnan(best) || std::abs(s - near) < std::abs(best - near)) best = s;
+      }
+      prev = cur;
+    }
+    return best;
+  }
+
+  SurfacePoint sample(uint64_t seed, uint64_t index) const override {
+    auto u = [&](int k) { return detail::uniform(seed, 8 * index + uint64_t(k)); };
+    Vec3 q, n;
+    switch (kind_) {
+      case ShapeKind::sphere: {
+        const double z = 2 * u(0) - 1, phi = 2 * kPi * u(1), r = std::sqrt(std::max(0.0, 1 - z * z));
+        q = n = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+        break;
+      }
+      case ShapeKind::torus: {
+        // Area element (R + r cos v): rejection sampling on v, from a
+        // sub-stream of this index (acceptance 1/1.4; 64 tries never all fail
+        // in practice, and the last one is taken if they do).
+        double v = 0;
+        for (uint64_t k = 0; k < 64; ++k) {
+          v = 2 * kPi * detail::uniform(seed ^ 0x9e37u, 128 * index + 2 * k);
+          if (detail::uniform(seed ^ 0x9e37u, 128 * index + 2 * k + 1) * (kTorusR + kTorusr) <=
+              kTorusR + kTorusr * std::cos(v))
+            break;
+        }
+        const double w = 2 * kPi * detail::uniform(seed ^ 0x5bd1e995u, index);
+        n = Vec3(std::cos(v) * std::cos(w), std::cos(v) * std::sin(w), std::sin(v));
+        q = Vec3(kTorusR * std::cos(w), kTorusR * std::sin(w), 0) + kTorusr * n;
+        break;
+      }
+      case ShapeKind::box: {
+        const Vec3& h = kBoxHalf;
+        const double areas[3] = {h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};
+        const double total = areas[0] + areas[1] + areas[2];
+        double pick = u(0) * total;
+        int axis = 0;
+        while (axis < 2 && pick > areas[axis]) pick -= areas[axis++];
+        const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+        q[axis] = u(1) < 0.5 ? -h[axis] : h[axis];
+        q[a1] = (2 * u(2) - 1) * h[a1];
+        q[a2] = (2 * u(3) - 1) * h[a2];
+        n = Vec3::Zero();
+        n[axis] = q[axis] > 0 ? 1 : -1;
+        break;
+      }
+      default: {  // cylinder
+        const double side = 2 * kPi * kCylR * 2 * kCylH, cap = kPi * kCylR * kCylR;
+        const double phi = 2 * kPi * u(1);
+        if (u(0) * (side + 2 * cap) < side) {
+          n = Vec3(std::cos(phi), std::sin(phi), 0);
+          q = Vec3(kCylR * n.x(), kCylR * n.y(), (2 * u(2) - 1) * kCylH);
+        } else {
+          const double r = kCylR * std::sqrt(u(2));
+          const double z = u(3) < 0.5 ? -kCylH : kCylH;
+          q = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+          n = Vec3(0, 0, z > 0 ? 1 : -1);
+        }
+        break;
+      }
+    }
+    return {t_ + A_ * q, (N_ * n).normalized()};
+  }
+
+  double area() const override {
+    double a = 0;
+    switch (kind_) {
+      case ShapeKind::sphere: a = 4 * kPi; break;
+      case ShapeKind::torus: a = 4 * kPi * kPi * kTorusR * kTorusr; break;
+      case ShapeKind::box: a = 8 * (kBoxHalf.x() * kBoxHalf.y() + kBoxHalf.y() * kBoxHalf.z() + kBoxHalf.x() * kBoxHalf.z()); break;
+      default: a = 2 * kPi * kCylR * 2 * kCylH + 2 * kPi * kCylR * kCylR; break;
+    }
+    return a * scale_ * scale_;
+  }
+  double volume() const override { return shape_volume(kind_) * std::abs(A_.determinant()); }
+
+  std::vector<std::array<Vec3, 2>> sharp_edges(double angle_deg) const override {
+    std::vector<std::array<Vec3, 2>> out;
+    auto add = [&](const Vec3& a, const Vec3& b) { out.push_back({t_ + A_ * a, t_ + A_ * b}); };
+    if (kind_ == ShapeKind::box && angle_deg < 90) {
+      const Vec3& h = kBoxHalf;
+      for (int axis = 0; axis < 3; ++axis)
+        for (int s1 : {-1, 1})
+          for (int s2 : {-1, 1}) {
+            Vec3 a, b;
+            const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+            a[axis] = -h[axis];
+            b[axis] = h[axis];
+            a[a1] = b[a1] = s1 * h[a1];
+            a[a2] = b[a2] = s2 * h[a2];
+            add(a, b);
+          }
+    } else if (kind_ == ShapeKind::cylinder && angle_deg < 90) {
+      const int n = 1024;
+      for (double z : {-kCylH, kCylH})
+        for (int i = 0; i < n; ++i) {
+          const double p0 = 2 * kPi * i / n, p1 = 2 * kPi * (i + 1) / n;
+          add(Vec3(kCylR * std::cos(p0), kCylR * std::sin(p0), z), Vec3(kCylR * std::cos(p1), kCylR * std::sin(p1), z));
+        }
+    }
+    return out;
+  }
+
+ private:
+  // Picks, among candidate outward normals (the faces a crease point lies
+  // on), the one best aligned with the hint, else the first.
+  static Vec3 pick(const Vec3* candidates, int count, const Vec3& hint) {
+    int best = 0;
+    if (hint != Vec3::Zero())
+      for (int i = 1; i < count; ++i)
+        if (candidates[i].dot(hint) > candidates[best].dot(hint)) best = i;
+    return candidates[best];
+  }
+
+  // Exact closest point q on the model surface and outward normal n.
+  void closest_model(const Vec3& m, const Vec3& hint, Vec3& q, Vec3& n) const {
+    switch (kind_) {
+      case ShapeKind::sphere: {
+        const double r = m.norm();
+        n = r > 0 ? Vec3(m / r) : Vec3::UnitX();
+        q = n;
+        return;
+      }
+      case ShapeKind::torus: {
+        const double rho = std::hypot(m.x(), m.y());
+        const Vec3 dir = rho > 0 ? Vec3(m.x() / rho, m.y() / rho, 0) : Vec3::UnitX();
+        const Vec3 c = kTorusR * dir, d = m - c;
+        const double len = d.norm();
+        n = len > 0 ? Vec3(d / len) : dir;
+        q = c + kTorusr * n;
+        return;
+      }
+      case ShapeKind::box: {
+        const Vec3& h = kBoxHalf;
+        Vec3 cand[3];
+        int count = 0;
+        if ((m.cwiseAbs().array() > h.array()).any()) {
+          // Outside: clamp; the faces q lies on are candidates, the one with
+          // the largest excess first.
+          q = m.cwiseMax(-h).cwiseMin(h);
+          int order[3] = {0, 1, 2};
+          std::sort(order, order + 3, [&](int a, int b) { return std::abs(m[a]) - h[a] > std::abs(m[b]) - h[b]; });
+          for (int a : order)
+            if (std::abs(q[a]) == h[a]) cand[count++] = (q[a] > 0 ? 1.0 : -1.0) * Vec3::Unit(a);
+        } else {
+          // Inside: the nearest face(s).
+          double best = INFINITY;
+          for (int a = 0; a < 3; ++a) best = std::min(best, h[a] - std::abs(m[a]));
+          int axis = -1;
+          for (int a = 0; a < 3; ++a)
+            if (h[a] - std::abs(m[a]) == best) {
+              cand[count++] = (m[a] >= 0 ? 1.0 : -1.0) * Vec3::Unit(a);
+              if (axis < 0) axis = a;
+            }
+          q = m;
+          q[axis] = m[axis] >= 0 ? h[axis] : -h[axis];
+        }
+        n = pick(cand, count, hint);
+        return;
+      }
+      default: {  // capped cylinder
+        const double rho = std::hypot(m.x(), m.y());
+        const Vec3 dir = rho > 0 ? Vec3(m.x() / rho, m.y() / rho, 0) : Vec3::UnitX();
+        const Vec3 cap = Vec3(0, 0, m.z() >= 0 ? 1 : -1);
+        const double to_side = kCylR - rho, to_cap = kCylH - std::abs(m.z());
+        if (to_side >= 0 && to_cap >= 0) {  // inside: the nearer of side and cap
+          if (to_side <= to_cap) {
+            q = Vec3(kCylR * dir.x(), kCylR * dir.y(), m.z());
+          } else {
+            q = Vec3(m.x(), m.y(), m.z() >= 0 ? kCylH : -kCylH);
+          }
+          const Vec3 cand[2] = {to_side <= to_cap ? dir : cap, to_side <= to_cap ? cap : dir};
+          n = pick(cand, to_side == to_cap ? 2 : 1, hint);
+          return;
+        }
+        const double r = std::min(rho, kCylR);
+        q = Vec3(r * dir.x(), r * dir.y(), std::clamp(m.z(), -kCylH, kCylH));
+        const bool on_side = r == kCylR, on_cap = std::abs(q.z()) == kCylH;
+        const bool side_first = -to_side >= -to_cap;  // larger excess first
+        Vec3 cand[2];
+        int count = 0;
+        if (on_side && on_cap) {
+          cand[count++] = side_first ? dir : cap;
+          cand[count++] = side_first ? cap : dir;
+        } else {
+          cand[count++] = on_side ? dir : cap;
+        }
+        n = pick(cand, count, hint);
+        return;
+      }
+    }
+  }
+
+  ShapeKind kind_;
+  Mat3 A_;
+  Vec3 t_;
+  Mat3 Ainv_, N_;
+  double scale_;
+};
+
+// ------------------------------------------------------------- mesh
+class MeshTruth final : public Truth {
+ public:
+  MeshTruth(Mesh mesh, std::string name) : mesh_(std::move(mesh)), name_(std::move(name)), query_(mesh_) {
+    volume_ = signed_volume(mesh_);
+  }
+  std::string describe() const override {
+    return name_ + " (mesh, " + std::to_string(mesh_.triangles.size()) + " faces)";
+  }
+  SurfacePoint closest(const Vec3& p, const Vec3* normal_hint) const override {
+    const auto hit = query_.closest(p, normal_hint ? *normal_hint : Vec3::Zero());
+    return {hit.point, query_.normal(hit.face)};
+  }
+  bool contains(const Vec3& p) const override { return mesh_contains(mesh_, p); }
+  double crossing(const Vec3& a, const Vec3& b, double near) const override {
+    thread_local std::vector<double> hits;
+    query_.segment_hits(a, b, hits);
+    double best = NAN;
+    for (double s : hits)
+      if (std::isnan(best) || std::abs(s - near) < std::abs(best - near)) best = s;
+    return best;
+  }
+  SurfacePoint sample(uint64_t seed, uint64_t index) const override {
+    const auto hit = query_.sample(seed, index);
+    return {hit.point, query_.normal(hit.face)};
+  }
+  double area() const override { return query_.area(); }
+  double volume() const override { return std::abs(volume_); }
+  std::vector<std::array<Vec3, 2>> sharp_edges(double angle_deg) const override {
+    std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> faces;
+    for (uint32_t f = 0; f < mesh_.triangles.size(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t u = mesh_.triangles[f][size_t(k)], v = mesh_.triangles[f][size_t((k + 1) % 3)];
+        faces[{std::min(u, v), std::max(u, v)}].push_back(f);
+      }
+    const double cos_limit = std::cos(angle_deg * kPi / 180);
+    std::vector<std::array<Vec3, 2>> out;
+    for (const auto& [e, fs] : faces)
+      if (fs.size() == 2 && query_.normal(fs[0]).dot(query_.normal(fs[1])) < cos_limit)
+        out.push_back({mesh_.positions[e.first], mesh_.positions[e.second]});
+    return out;
+  }
+
+ private:
+  Mesh mesh_;
+  std::string name_;
+  detail::MeshQuery query_;
+  double volume_ = 0;
+};
+
+Mesh transformed(const Mesh& m, const Mat3& linear, const Vec3& translation) {
+  Mesh out;
+  out.triangles = m.triangles;
+  out.positions.reserve(m.positions.size());
+  for (const Vec3& p : m.positions) out.positions.push_back(translation + linear * p);
+  if (linear.determinant() < 0)
+    for (auto& t : out.triangles) std::swap(t[1], t[2]);
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<Truth> shape_truth(ShapeKind kind, const Mat3& linear, const Vec3& translation) {
+  if (kind == ShapeKind::cad_part)
+    return mesh_truth(transformed(cad_part_mesh(), linear, translation), shape_name(kind));
+  return std::make_unique<AnalyticTruth>(kind, linear, translation);
+}
+
+std::unique_ptr<Truth> mesh_truth(Mesh physical_mesh, const std::string& name) {
+  return std::make_unique<MeshTruth>(std::move(physical_mesh), name);
+}
+
+std::string format_transform(const Mat3& linear, const Vec3& translation) {
+  std::ostringstream t;
+  t.precision(17);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) t << linear(r, c) << ' ';
+  t << translation.x() << ' ' << translation.y() << ' ' << translation.z();
+  return t.str();
+}
+
+bool parse_transform(const std::string& text, Mat3& linear, Vec3& translation) {
+  std::istringstream in(text);
+  double v[12];
+  for (double& x : v)
+    if (!(in >> x) || !std::isfinite(x)) return false;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) linear(r, c) = v[3 * r + c];
+  translation = Vec3(v[9], v[10], v[11]);
+  return std::abs(linear.determinant()) > 0;
+}
+
+std::unique_ptr<Truth> resolve_truth(const std::string& spec, const ScalarVolume* volume) {
+  Mat3 linear = Mat3::Identity();
+  Vec3 translation = Vec3::Zero();
+  bool have_transform = false;
+  std::string meta_shape, meta_mesh;
+  if (volume) {
+    auto get = [&](const char* key) {
+      auto it = volume->metadata.find(key);
+      return it == volume->metadata.end() ? std::string() : it->second;
+    };
+    meta_shape = get(kShapeKey);
+    meta_mesh = get(kTruthMeshKey);
+    const std::string tr = get(kModelToPhysicalKey);
+    if (!tr.empty()) {
+      if (!parse_transform(tr, linear, translation))
+        throw InputError(volume->source, std::string("malformed ") + kModelToPhysicalKey + " metadata");
+      have_transform = true;
+    }
+  }
+  std::string what = spec.empty() ? (!meta_shape.empty() ? meta_shape : meta_mesh) : spec;
+  if (what.empty())
+    throw UsageError("no truth: give --truth SHAPE|MESH, or a --volume written by `voxpress generate` or "
+                     "`voxpress voxelize`");
+  for (ShapeKind k : all_shapes())
+    if (what == shape_name(k)) {
+      if (!have_transform)
+        throw UsageError(std::string("the ") + shape_name(k) +
+                         " truth needs its placement: give the --volume written by `voxpress generate`");
+      return shape_truth(k, linear, translation);
+    }
+  // A mesh file: the stored transform applies when the volume was voxelized from a model.
+  Mesh model = read_mesh(what);
+  const std::string name = std::filesystem::path(what).filename().string();
+  return mesh_truth(have_transform ? transformed(model, linear, translation) : std::move(model), name);
+}
+
+}  // namespace voxpress
