@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 namespace voxpress::cli {
@@ -128,6 +129,12 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 }
 
 uint64_t peak_rss_bytes() {
+  // VmHWM belongs to this address space (reset by exec), unlike ru_maxrss,
+  // which a child spawned with vfork semantics inherits from its parent.
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("VmHWM:", 0) == 0) return uint64_t(std::stoull(line.substr(6))) * 1024;
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   return uint64_t(ru.ru_maxrss) * 1024;

@@ -74,7 +74,7 @@ class Stopwatch {
 nlohmann::json lattice_json(const Lattice& l);
 /// Writes a JSON document atomically (pretty-printed).
 void write_json(const std::string& path, const nlohmann::json& j);
-/// Peak resident memory of this process so far, in bytes.
+/// Peak resident memory of this process so far (VmHWM), in bytes.
 uint64_t peak_rss_bytes();
 
 /// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).

@@ -50,31 +50,39 @@ Bvh::Bvh(std::span<const Aabb> boxes) : boxes_(boxes.begin(), boxes.end()) {
     };
     double best_cost = INFINITY;
     int best_axis = -1, best_bin = 0;
+    // One pass over the node's primitives fills the bins of all three axes.
+    Aabb bin_box[3][kBins];
+    uint32_t bin_count[3][kBins] = {};
+    Vec3 inv_ext;
     for (int axis = 0; axis < 3; ++axis) {
-      const double lo = cbox.lo[axis], ext = cbox.hi[axis] - lo;
-      if (!(ext > 0)) continue;
-      Aabb bin_box[kBins];
-      uint32_t bin_count[kBins] = {};
-      for (uint32_t i = job.first; i < job.first + job.count; ++i) {
-        const int b = std::min(kBins - 1, int(kBins * (centre[order_[i]][axis] - lo) / ext));
-        bin_box[b].grow(boxes_[order_[i]]);
-        ++bin_count[b];
+      const double ext = cbox.hi[axis] - cbox.lo[axis];
+      inv_ext[axis] = ext > 0 ? kBins / ext : 0;
+    }
+    for (uint32_t i = job.first; i < job.first + job.count; ++i) {
+      const uint32_t p = order_[i];
+      for (int axis = 0; axis < 3; ++axis) {
+        const int b = std::min(kBins - 1, int((centre[p][axis] - cbox.lo[axis]) * inv_ext[axis]));
+        bin_box[axis][b].grow(boxes_[p]);
+        ++bin_count[axis][b];
       }
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      if (inv_ext[axis] == 0) continue;
       double right_area[kBins];
       uint32_t right_count[kBins];
       Aabb acc;
       uint32_t count = 0;
       for (int b = kBins - 1; b > 0; --b) {
-        if (bin_count[b]) acc.grow(bin_box[b]);
-        count += bin_count[b];
+        if (bin_count[axis][b]) acc.grow(bin_box[axis][b]);
+        count += bin_count[axis][b];
         right_area[b] = count ? half_area(acc) : 0;
         right_count[b] = count;
       }
       acc = Aabb();
       count = 0;
       for (int b = 0; b < kBins - 1; ++b) {
-        if (bin_count[b]) acc.grow(bin_box[b]);
-        count += bin_count[b];
+        if (bin_count[axis][b]) acc.grow(bin_box[axis][b]);
+        count += bin_count[axis][b];
         if (count == 0 || right_count[b + 1] == 0) continue;
         const double cost = half_area(acc) * count + right_area[b + 1] * right_count[b + 1];
         if (cost < best_cost) {
@@ -95,10 +103,10 @@ Bvh::Bvh(std::span<const Aabb> boxes) : boxes_(boxes.begin(), boxes.end()) {
       }
       continue;
     }
-    const double lo = cbox.lo[best_axis], ext = cbox.hi[best_axis] - lo;
+    const double lo = cbox.lo[best_axis], inv = inv_ext[best_axis];
     auto begin = order_.begin() + job.first;
-    auto mid_it = std::stable_partition(begin, begin + job.count, [&](uint32_t p) {
-      return std::min(kBins - 1, int(kBins * (centre[p][best_axis] - lo) / ext)) <= best_bin;
+    auto mid_it = std::partition(begin, begin + job.count, [&](uint32_t p) {
+      return std::min(kBins - 1, int((centre[p][best_axis] - lo) * inv)) <= best_bin;
     });
     const uint32_t half = uint32_t(mid_it - begin);
     jobs.push_back({index, true, job.first + half, job.count - half});

@@ -10,17 +10,6 @@ double diagonal(const Vec3& a, const Vec3& b, const Vec3& c) {
   return (a.cwiseMax(b).cwiseMax(c) - a.cwiseMin(b).cwiseMin(c)).norm();
 }
 
-template <class Piece>
-std::vector<Aabb> piece_boxes(const std::vector<Piece>& pieces) {
-  std::vector<Aabb> boxes(pieces.size());
-  for (size_t i = 0; i < pieces.size(); ++i) {
-    boxes[i].grow(pieces[i].a);
-    boxes[i].grow(pieces[i].b);
-    boxes[i].grow(pieces[i].c);
-  }
-  return boxes;
-}
-
 double box_dist2(const Aabb& b, const Vec3& p) {
   const Vec3 d = (b.lo - p).cwiseMax(p - b.hi).cwiseMax(0.0);
   return d.squaredNorm();
@@ -59,47 +48,67 @@ Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-std::vector<MeshQuery::Piece> MeshQuery::make_pieces(const Mesh& mesh) {
-  std::vector<MeshQuery::Piece> pieces;
-  const auto& P = mesh.positions;
-  std::vector<double> diag(mesh.triangles.size());
+void MeshQuery::make_prims() {
+  const auto& P = mesh_.positions;
+  const size_t F = mesh_.triangles.size();
+  std::vector<double> diag(F);
   Aabb all;
-  for (size_t f = 0; f < diag.size(); ++f) {
-    const auto& t = mesh.triangles[f];
+  for (size_t f = 0; f < F; ++f) {
+    const auto& t = mesh_.triangles[f];
     diag[f] = diagonal(P[t[0]], P[t[1]], P[t[2]]);
     for (uint32_t v : t) all.grow(P[v]);
   }
-  if (diag.empty()) return pieces;
+  prims_.reserve(F);
+  if (F == 0) return;
   std::vector<double> sorted = diag;
-  std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
-  const double limit = std::max(4 * sorted[sorted.size() / 2], (all.hi - all.lo).norm() / 16);
-  pieces.reserve(mesh.triangles.size());
-  std::vector<MeshQuery::Piece> todo;
-  for (size_t f = 0; f < diag.size(); ++f) {
-    const auto& t = mesh.triangles[f];
+  std::nth_element(sorted.begin(), sorted.begin() + long(F / 2), sorted.end());
+  const double limit = std::max(4 * sorted[F / 2], (all.hi - all.lo).norm() / 16);
+  std::vector<Piece> todo;
+  for (size_t f = 0; f < F; ++f) {
+    if (diag[f] <= limit) {
+      prims_.push_back({uint32_t(f), -1});
+      continue;
+    }
+    const auto& t = mesh_.triangles[f];
     todo.push_back({P[t[0]], P[t[1]], P[t[2]], uint32_t(f)});
     int budget = 256;  // pieces per face at most
     while (!todo.empty()) {
-      MeshQuery::Piece q = todo.back();
+      Piece q = todo.back();
       todo.pop_back();
       if (diagonal(q.a, q.b, q.c) <= limit || budget <= 1) {
-        pieces.push_back(q);
+        prims_.push_back({q.face, int32_t(pieces_.size())});
+        pieces_.push_back(q);
         continue;
       }
       // Bisect the longest edge: rotate so that it is (a, b).
       const double ab = (q.b - q.a).squaredNorm(), bc = (q.c - q.b).squaredNorm(), ca = (q.a - q.c).squaredNorm();
-      if (bc >= ab && bc >= ca) q = {q.b, q.c, q.a, q.face};
-      else if (ca >= ab && ca >= bc) q = {q.c, q.a, q.b, q.face};
+      if (bc >= ab && bc >= ca)
+        q = {q.b, q.c, q.a, q.face};
+      else if (ca >= ab && ca >= bc)
+        q = {q.c, q.a, q.b, q.face};
       const Vec3 m = 0.5 * (q.a + q.b);
       todo.push_back({q.a, m, q.c, q.face});
       todo.push_back({m, q.b, q.c, q.face});
       --budget;
     }
   }
-  return pieces;
 }
 
-MeshQuery::MeshQuery(const Mesh& mesh) : mesh_(mesh), pieces_(make_pieces(mesh)), bvh_(piece_boxes(pieces_)) {
+std::vector<Aabb> MeshQuery::prim_boxes() const {
+  std::vector<Aabb> boxes(prims_.size());
+  for (size_t i = 0; i < prims_.size(); ++i) {
+    const Vec3 *a, *b, *c;
+    corners(prims_[i], a, b, c);
+    boxes[i].grow(*a);
+    boxes[i].grow(*b);
+    boxes[i].grow(*c);
+  }
+  return boxes;
+}
+
+// prims_ and pieces_ are declared (so constructed) before bvh_, which is built
+// from them once make_prims() has filled them.
+MeshQuery::MeshQuery(const Mesh& mesh) : mesh_(mesh), bvh_((make_prims(), prim_boxes())) {
   normals_.resize(mesh.triangles.size());
   cumulative_.resize(mesh.triangles.size());
   double acc = 0;
@@ -136,11 +145,13 @@ MeshQuery::Hit MeshQuery::closest(const Vec3& p, const Vec3& hint) const {
     if (box_dist2(node.box, p) > tie_limit()) continue;
     if (node.count) {
       for (uint32_t k = 0; k < node.count; ++k) {
-        const Piece& pc = pieces_[bvh_.order()[node.first + k]];
-        const Vec3 q = closest_on_triangle(p, pc.a, pc.b, pc.c);
+        const Prim& pr = prims_[bvh_.order()[node.first + k]];
+        const Vec3 *a, *b, *c;
+        corners(pr, a, b, c);
+        const Vec3 q = closest_on_triangle(p, *a, *b, *c);
         const double d2 = (q - p).squaredNorm();
         if (d2 < best.dist2) {
-          best = {q, pc.face, d2};
+          best = {q, pr.face, d2};
           int kept = 0;  // earlier candidates still tied with the new best
           for (int t = 0; t < nties; ++t)
             if (tie_d2[t] <= tie_limit()) {
@@ -150,7 +161,7 @@ MeshQuery::Hit MeshQuery::closest(const Vec3& p, const Vec3& hint) const {
           nties = kept;
         }
         if (d2 <= tie_limit() && nties < kTies) {
-          tie_face[nties] = pc.face;
+          tie_face[nties] = pr.face;
           tie_d2[nties++] = d2;
         }
       }
@@ -200,8 +211,9 @@ void MeshQuery::segment_hits(const Vec3& a, const Vec3& b, std::vector<double>& 
       continue;
     }
     for (uint32_t k = 0; k < node.count; ++k) {
-      const Piece& pc = pieces_[bvh_.order()[node.first + k]];
-      const Vec3 &v0 = pc.a, &v1 = pc.b, &v2 = pc.c;
+      const Vec3 *pa, *pb, *pc;
+      corners(prims_[bvh_.order()[node.first + k]], pa, pb, pc);
+      const Vec3 &v0 = *pa, &v1 = *pb, &v2 = *pc;
       const Vec3 e1 = v1 - v0, e2 = v2 - v0, h = d.cross(e2);
       const double det = e1.dot(h);
       if (det == 0) continue;

@@ -48,17 +48,37 @@ class MeshQuery {
   Hit sample(uint64_t seed, uint64_t index) const;
   const Mesh& mesh() const { return mesh_; }
   size_t faces() const { return mesh_.triangles.size(); }
-  size_t pieces() const { return pieces_.size(); }
+  size_t pieces() const { return prims_.size(); }
 
  private:
   struct Piece {
     Vec3 a, b, c;
     uint32_t face;
   };
-  static std::vector<Piece> make_pieces(const Mesh& mesh);
+  // A BVH primitive: a whole face (piece < 0) or a piece of a split face.
+  struct Prim {
+    uint32_t face;
+    int32_t piece;
+  };
+  void make_prims();
+  void corners(const Prim& p, const Vec3*& a, const Vec3*& b, const Vec3*& c) const {
+    if (p.piece < 0) {
+      const auto& t = mesh_.triangles[p.face];
+      a = &mesh_.positions[t[0]];
+      b = &mesh_.positions[t[1]];
+      c = &mesh_.positions[t[2]];
+    } else {
+      const Piece& q = pieces_[size_t(p.piece)];
+      a = &q.a;
+      b = &q.b;
+      c = &q.c;
+    }
+  }
+  std::vector<Aabb> prim_boxes() const;
 
   const Mesh& mesh_;
-  std::vector<Piece> pieces_;
+  std::vector<Prim> prims_;
+  std::vector<Piece> pieces_;  // only for faces that were split
   std::vector<Vec3> normals_;
   std::vector<double> cumulative_;  // prefix sums of face areas
   Bvh bvh_;

@@ -43,9 +43,10 @@ class AnalyticTruth final : public Truth {
   bool contains(const Vec3& p) const override { return shape_contains(kind_, Ainv_ * (p - t_)); }
 
   double crossing(const Vec3& a, const Vec3& b, double near) const override {
-    // Bisection on the exact inside test; sticks cross the smooth analytic
-    // surfaces at most a few times, so search the bracket nearest `near`.
-    const int n = 64;
+    // Bisection on the exact inside test. A one-voxel stick crosses these
+    // smooth surfaces at most a few times: scan 16 sub-intervals for sign
+    // changes, bisect each to machine precision, keep the one nearest `near`.
+    const int n = 16;
     double best = NAN;
     bool prev = contains(a);
     for (int i = 1; i <= n; ++i) {
@@ -54,7 +55,7 @@ class AnalyticTruth final : public Truth {
       if (cur != prev) {
         double lo = s0, hi = s1;
         const bool lo_in = prev;
-        for (int it = 0; it < 60; ++it) {
+        for (int it = 0; it < 50; ++it) {
           const double mid = 0.5 * (lo + hi);
           (contains(a + mid * (b - a)) == lo_in ? lo : hi) = mid;
         }
