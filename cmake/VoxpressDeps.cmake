@@ -12,6 +12,7 @@ voxpress_require(Eigen3 libeigen3-dev 3.3 NO_MODULE)
 voxpress_require(TBB libtbb-dev)
 voxpress_require(ZLIB zlib1g-dev)
 voxpress_require(TIFF libtiff-dev)
+voxpress_require(PNG libpng-dev)
 # Debian 12's NIFTIConfig.cmake points at /usr/lib/libznz.so.3.0.0, which the
 # package does not ship; locate nifti_clib directly instead.
 find_path(NIFTI_INCLUDE_DIR nifti2_io.h PATH_SUFFIXES nifti)

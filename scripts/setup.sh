@@ -8,7 +8,7 @@ with_tests=0
 [ "${1:-}" = "--tests" ] && with_tests=1
 
 packages=(build-essential cmake ninja-build pkg-config
-          libeigen3-dev libtbb-dev zlib1g-dev libtiff-dev libnifti2-dev
+          libeigen3-dev libtbb-dev zlib1g-dev libtiff-dev libpng-dev libnifti2-dev
           libtinygltf-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
           libgtest-dev libgmock-dev libbenchmark-dev)
 [ $with_tests = 1 ] && packages+=(nodejs)

@@ -111,6 +111,51 @@ BinaryVolume load_binary(const std::string& path, const InputOptions& in, const 
   return b;
 }
 
+void PressCli::bind(CLI::App& cmd) {
+  auto* g = cmd.add_option_group("smoothing", "Pressing (constrained bilaplacian smoothing)");
+  g->add_option("--iterations", options.iterations, "Maximum iterations")->capture_default_str();
+  g->add_option("--tolerance", options.tolerance, "Stop when no vertex moves more than this (fraction of a stick)")
+      ->capture_default_str();
+  g->add_option("--step", options.step, "s in C'' = C + s^2 L^2(C)")->capture_default_str();
+  g->add_option("--arc-length", options.arc_length, "d: virtual-neighbour distance, in cells")->capture_default_str();
+  g->add_option("--margin", options.margin, "Keep t in [margin, 1 - margin]")->capture_default_str();
+  g->add_option("--levels", options.levels, "Coarse-to-fine stages of d (1: the paper's single d)")
+      ->capture_default_str();
+  g->add_option("--momentum", options.momentum, "Heavy-ball momentum (0: the paper's plain iteration)")
+      ->capture_default_str();
+  g->add_option("--weighting", weighting, "equal | normal | tangent (combining a stick's two proposals)")
+      ->capture_default_str();
+  g->add_flag("--plain", plain, "Bilaplacian of the actual neighbours, no arc-length resampling (paper Fig. 5)");
+}
+
+PressOptions PressCli::resolve() const {
+  PressOptions o = options;
+  if (weighting == "equal")
+    o.weighting = PressOptions::Weighting::equal;
+  else if (weighting == "normal")
+    o.weighting = PressOptions::Weighting::normal;
+  else if (weighting == "tangent")
+    o.weighting = PressOptions::Weighting::tangent;
+  else
+    throw UsageError("--weighting must be equal, normal or tangent");
+  o.resample = !plain;
+  if (o.iterations < 0) throw UsageError("--iterations must be >= 0");
+  if (!(o.margin > 0 && o.margin < 0.5)) throw UsageError("--margin must be in (0, 0.5)");
+  if (!(o.arc_length > 0) || !(o.step > 0)) throw UsageError("--arc-length and --step must be > 0");
+  if (o.levels < 1 || o.levels > 8) throw UsageError("--levels must be between 1 and 8");
+  if (!(o.momentum >= 0 && o.momentum < 1)) throw UsageError("--momentum must be in [0, 1)");
+  return o;
+}
+
+nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
+  return {{"iterations", st.iterations},    {"max_iterations", o.iterations},
+          {"last_max_change", st.last_max_change}, {"curves", st.curves},
+          {"fresh", st.fresh},              {"frozen", st.frozen},
+          {"seconds", st.seconds},          {"levels", o.levels},
+          {"momentum", o.momentum},         {"arc_length", o.arc_length},
+          {"step", o.step},                 {"resample", o.resample}};
+}
+
 nlohmann::json lattice_json(const Lattice& l) {
   nlohmann::json j;
   j["dims"] = {l.dims[0], l.dims[1], l.dims[2]};

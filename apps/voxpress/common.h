@@ -62,6 +62,17 @@ ScalarVolume load_volume(const std::string& path, const InputOptions& in, const 
 /// Reads, binarises and checks that the volume is neither empty nor full.
 BinaryVolume load_binary(const std::string& path, const InputOptions& in, const Global& g);
 
+/// The smoothing options of `press` and `press2d`.
+struct PressCli {
+  PressOptions options;
+  std::string weighting = "equal";
+  bool plain = false;
+  void bind(CLI::App& cmd);
+  /// The options with the weighting and --plain applied; throws UsageError.
+  PressOptions resolve() const;
+};
+nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o);
+
 /// Wall-clock stopwatch for --stats-json.
 class Stopwatch {
  public:
@@ -87,5 +98,7 @@ void register_generate(CLI::App& app, Global& g);
 void register_check(CLI::App& app, Global& g);
 void register_voxelize(CLI::App& app, Global& g);
 void register_eval(CLI::App& app, Global& g);
+void register_press(CLI::App& app, Global& g);
+void register_press2d(CLI::App& app, Global& g);
 
 }  // namespace voxpress::cli

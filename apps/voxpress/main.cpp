@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   cli::register_check(app, g);
   cli::register_voxelize(app, g);
   cli::register_eval(app, g);
+  cli::register_press(app, g);
+  cli::register_press2d(app, g);
 
   try {
     app.parse(argc, argv);

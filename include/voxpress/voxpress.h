@@ -12,8 +12,10 @@
 #include "voxpress/extract/cube_cases.h"
 #include "voxpress/extract/sticks.h"
 #include "voxpress/io/atomic_file.h"
+#include "voxpress/io/image_io.h"
 #include "voxpress/io/mesh_io.h"
 #include "voxpress/io/volume_io.h"
+#include "voxpress/smooth/pressing.h"
 
 namespace voxpress {
 inline constexpr const char* kVersion = "0.1.0";

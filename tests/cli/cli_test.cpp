@@ -20,12 +20,15 @@ size_t count_lines(const std::string& s) {
 }
 
 TEST(Cli, HelpOnEveryCommand) {
-  for (const std::string cmd : {"", "info", "extract", "generate", "check", "voxelize", "eval"}) {
+  for (const std::string cmd : {"", "info", "extract", "generate", "check", "voxelize", "eval", "press", "press2d"}) {
     std::string out;
     EXPECT_EQ(run_cli(cmd + " --help", &out), 0) << cmd;
     EXPECT_NE(out.find("Usage"), std::string::npos) << cmd;
   }
   std::string out;
+  ASSERT_EQ(run_cli("--help", &out), 0);
+  for (const std::string cmd : {"extract", "press", "press2d", "eval", "voxelize"})
+    EXPECT_NE(out.find(cmd), std::string::npos) << "--help does not list " << cmd;
   EXPECT_EQ(run_cli("--version", &out), 0);
   EXPECT_NE(out.find("voxpress"), std::string::npos);
 }
@@ -231,6 +234,120 @@ TEST(Cli, SharedLabelMapsPerLabel) {
   EXPECT_NE(out.find("0 violations"), std::string::npos);
   EXPECT_EQ(run_cli("-q extract " + f + " --label 4242 -o " + tmp.path("none.stl"), &out), 1);
   EXPECT_NE(out.find("4242"), std::string::npos);
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(Cli, PressSmoothsAndKeepsEverySampleOnItsSide) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate torus --res 48 --rotate random:5 --spacing 1,1,1.4 -o " + tmp.path("t.nrrd"), &out), 0)
+      << out;
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("t.nrrd") + " -o " + tmp.path("mid.ply"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("p.ply") + " --check --stats-json " +
+                        tmp.path("s.json"),
+                    &out),
+            0)
+      << out;
+  const auto st = nlohmann::json::parse(std::ifstream(tmp.path("s.json")));
+  EXPECT_EQ(st["method"], "pressing");
+  EXPECT_GT(st["pressing"]["iterations"].get<int>(), 0);
+  EXPECT_LE(st["pressing"]["iterations"].get<int>(), st["pressing"]["max_iterations"].get<int>());
+  EXPECT_EQ(st["checks"]["classification_violations"], 0);
+  EXPECT_EQ(st["checks"]["mesh_ok"], true);
+  ASSERT_EQ(run_cli("check " + tmp.path("p.ply") + " --volume " + tmp.path("t.nrrd"), &out), 0) << out;
+  // Pressing is closer to the truth than the midpoint surface, in physical units too.
+  auto rms = [&](const std::string& mesh) {
+    EXPECT_EQ(run_cli("-q eval " + tmp.path(mesh) + " --volume " + tmp.path("t.nrrd") + " --samples 20000 --json " +
+                          tmp.path("e.json"),
+                      &out),
+              0)
+        << out;
+    return nlohmann::json::parse(std::ifstream(tmp.path("e.json")))["voxels"]["result_to_truth"]["rms"].get<double>();
+  };
+  const double mid = rms("mid.ply"), pressed = rms("p.ply");
+  EXPECT_LT(pressed, 0.6 * mid) << "midpoint " << mid << ", pressed " << pressed;
+  // Options: a tolerance stops early; the same bytes for 1 and 2 threads.
+  ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("q.ply") + " --tolerance 0.05 --stats-json " +
+                        tmp.path("q.json"),
+                    &out),
+            0);
+  EXPECT_LT(nlohmann::json::parse(std::ifstream(tmp.path("q.json")))["pressing"]["iterations"].get<int>(),
+            st["pressing"]["iterations"].get<int>());
+  ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("one.ply") + " --threads 1", &out), 0);
+  ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("two.ply") + " --threads 2", &out), 0);
+  EXPECT_EQ(slurp(tmp.path("one.ply")), slurp(tmp.path("two.ply")));
+  EXPECT_EQ(slurp(tmp.path("one.ply")), slurp(tmp.path("p.ply")));
+  ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("w.obj") + " --weighting tangent --plain "
+                    "--iterations 20",
+                    &out),
+            0)
+      << out;
+  // Bad usage and bad input.
+  const auto before = tmp.files();
+  EXPECT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("x.ply") + " --weighting sideways", &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("x.ply") + " --margin 0.7", &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("x.ply") + " --iterations -1", &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("nope.nrrd") + " -o " + tmp.path("x.ply"), &out), 1);
+  EXPECT_EQ(count_lines(out), 1u) << out;
+  EXPECT_NE(out.find("nope.nrrd"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("x.xyz"), &out), 1);
+  EXPECT_NE(out.find("x.xyz"), std::string::npos) << out;
+  EXPECT_EQ(tmp.files(), before);
+}
+
+TEST(Cli, Press2dWritesContoursOverThePixels) {
+  test::TempDir tmp;
+  // A dark ring on white, as binary PGM.
+  const int w = 40, h = 32;
+  std::string pgm = "P5\n" + std::to_string(w) + " " + std::to_string(h) + "\n255\n";
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double r2 = (x - 19.6) * (x - 19.6) + (y - 15.3) * (y - 15.3);
+      pgm += char(r2 < 13 * 13 && r2 > 6 * 6 ? 10 : 250);
+    }
+  std::ofstream(tmp.path("ring.pgm"), std::ios::binary) << pgm;
+  std::string out;
+  ASSERT_EQ(run_cli("-q press2d " + tmp.path("ring.pgm") + " -o " + tmp.path("ring.svg") + " --midpoint --stats-json " +
+                        tmp.path("s.json"),
+                    &out),
+            0)
+      << out;
+  const std::string svg = slurp(tmp.path("ring.svg"));
+  EXPECT_NE(svg.find("<image"), std::string::npos);
+  size_t closes = 0;  // "Z " ends a contour in a path (base64 pixel data has no spaces)
+  for (size_t at = svg.find("Z "); at != std::string::npos; at = svg.find("Z ", at + 1)) ++closes;
+  EXPECT_EQ(closes, 4u) << "two paths (midpoint, pressed) of two contours each";
+  const auto st = nlohmann::json::parse(std::ifstream(tmp.path("s.json")));
+  EXPECT_EQ(st["pressing"]["curves"], 2);
+  EXPECT_EQ(st["width"], w);
+  // --invert turns the white background into the object: three contours (outer border, ring's two sides).
+  ASSERT_EQ(run_cli("-q press2d " + tmp.path("ring.pgm") + " -o " + tmp.path("inv.svg") + " --invert --no-pixels "
+                    "--stats-json " + tmp.path("i.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(tmp.path("i.json")))["pressing"]["curves"], 3);
+  EXPECT_EQ(slurp(tmp.path("inv.svg")).find("<image"), std::string::npos);
+  // Bad inputs: one line naming the file, exit 1, nothing written; bad usage: exit 2.
+  std::ofstream(tmp.path("white.pgm"), std::ios::binary) << "P5\n4 4\n255\n" << std::string(16, char(255));
+  std::ofstream(tmp.path("cut.pgm"), std::ios::binary) << pgm.substr(0, pgm.size() / 2);
+  std::ofstream(tmp.path("bad.png"), std::ios::binary) << "not a png";
+  const auto before = tmp.files();
+  for (const auto& [file, problem] : {std::pair<std::string, std::string>{"white.pgm", "no pixel is inside"},
+                                      {"cut.pgm", "truncated"},
+                                      {"bad.png", "PNG"},
+                                      {"missing.png", "no such file"}}) {
+    EXPECT_EQ(run_cli("-q press2d " + tmp.path(file) + " -o " + tmp.path("o.svg"), &out), 1) << file;
+    EXPECT_EQ(count_lines(out), 1u) << out;
+    EXPECT_NE(out.find(file), std::string::npos) << out;
+    EXPECT_NE(out.find(problem), std::string::npos) << out;
+  }
+  EXPECT_EQ(run_cli("-q press2d " + tmp.path("ring.pgm") + " -o " + tmp.path("o.png"), &out), 2);
+  EXPECT_EQ(tmp.files(), before);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 namespace voxpress {
 
+using Vec2 = Eigen::Vector2d;
 using Vec3 = Eigen::Vector3d;
 using Vec3i = Eigen::Matrix<int64_t, 3, 1>;
 using Mat3 = Eigen::Matrix3d;

@@ -1,0 +1,112 @@
+// voxpress/smooth/pressing.h — constrained bilaplacian smoothing on axis
+// slices (Pressing, Chica et al., Section 4).
+//
+// Every vertex slides along its stick only, t in [margin, 1 - margin], so the
+// surface becomes smooth yet can never cross a lattice sample: a triangle
+// whose corners lie inside the edges of one cell cannot contain a cell
+// corner, so no sample's winding number changes while vertices move.
+//
+// The 3D smoothing is decomposed into curve smoothing on the lattice planes
+// (Section 4, Fig. 3): the surface meets each lattice plane in closed
+// polylines whose vertices are the plane's sticks (SliceCurves, built once).
+// One iteration computes, on every curve and for every fresh vertex C:
+//   virtual neighbours C-, C+ at arc length d on either side (Fig. 6),
+//   L(C) = (C- + C+) / 2 - C, then L^2(C) = L(C) - (L(C-) + L(C+)) / 2 with
+//   L interpolated at the virtual points (Fig. 4, Eq. 1, two passes),
+//   the displacement s^2 L^2(C) projected onto the stick's line;
+// each stick lies in two planes, so it gets two proposals, which are averaged
+// (equal weights by default) before the clamp. Updates are simultaneous
+// (Jacobi), so the result does not depend on the order or the thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "voxpress/core/progress.h"
+#include "voxpress/extract/sticks.h"
+
+namespace voxpress {
+
+/// The lattice-plane cuts of a stick surface, as closed polylines of stick ids.
+/// Each stick lies in exactly two planes (those whose normal axis differs
+/// from its own), so it belongs to exactly two curves.
+struct SliceCurves {
+  /// Curves of plane family `a` (planes normal to axis a): curve c of
+  /// family a holds sticks ids[a][offsets[a][c] .. offsets[a][c + 1]), in
+  /// order along the curve; the last joins the first. Sorted by plane coordinate.
+  std::vector<uint32_t> ids[3];
+  std::vector<uint32_t> offsets[3];
+  size_t curve_count() const { return offsets[0].size() + offsets[1].size() + offsets[2].size() - 3; }
+};
+
+/// Builds the slice curves from the surface's triangles (a triangle edge whose
+/// two sticks share a lattice plane is a segment of that plane's cut). Throws
+/// std::logic_error if a stick does not have two neighbours in a plane
+/// (impossible for surfaces from extract_sticks).
+SliceCurves build_slice_curves(const StickSurface& surface);
+
+struct PressOptions {
+  int iterations = 100;        ///< maximum number of iterations (chosen by measurement: docs/BENCHMARKS.md)
+  double tolerance = 1e-4;     ///< stop once no vertex moved more than this (fraction of its stick)
+  double step = 0.85;          ///< s in C'' = C + s^2 L^2(C) (paper: 0.85)
+  double arc_length = 0.75;    ///< d, in cells of the curve's plane (paper: 0.75)
+  double margin = 0.01;        ///< t is kept in [margin, 1 - margin]
+  /// How the two proposals of a stick are combined (paper, Section 4):
+  /// equal weights, or weights proportional to |stick . curve normal| or to
+  /// |stick . curve tangent| in each plane.
+  enum class Weighting { equal, normal, tangent } weighting = Weighting::equal;
+  /// Beyond the paper — acceleration (same fixed point, reached in far fewer
+  /// iterations; docs/BENCHMARKS.md has the measurements):
+  /// coarse-to-fine: the iterations are split evenly into `levels` stages with
+  /// d multiplied by 2^(levels - 1), ..., 2, 1 (1: the paper's single d);
+  int levels = 2;
+  /// heavy-ball momentum: each update adds momentum times the vertex's
+  /// previous change of t (0: the paper's plain iteration).
+  double momentum = 0.8;
+  /// Arc-length resampling (paper, Fig. 5-6). false: the plain bilaplacian of
+  /// the actual curve neighbours, kept to reproduce Fig. 5's comparison.
+  bool resample = true;
+  Progress* progress = nullptr;
+};
+
+struct PressStats {
+  int iterations = 0;              ///< iterations run
+  double last_max_change = 0;      ///< largest |delta t| of the last iteration
+  size_t curves = 0, fresh = 0, frozen = 0;
+  double seconds = 0;
+};
+
+/// Smooths the surface in place (its t values). Vertices whose `frozen` flag
+/// is set (frozen.size() == stick_count(); empty = none) never move; curves
+/// pass through them as fixed points. `barrier` vertices (a subset of the
+/// frozen ones; empty = none) additionally cut the curves: a curve through
+/// barriers is smoothed as open pieces ending at them, so no virtual
+/// neighbour is taken across a barrier (used at sharp features).
+PressStats press(StickSurface& surface, const SliceCurves& curves, const PressOptions& options = {},
+                 const std::vector<uint8_t>& frozen = {}, const std::vector<uint8_t>& barrier = {});
+
+/// Convenience: builds the curves and presses.
+PressStats press(StickSurface& surface, const PressOptions& options = {});
+
+// ----------------------------------------------------------------- 2D
+/// A binary image's contours, pressed: the 2D counterpart, through the same
+/// curve kernel. Pixels are samples at integer (x, y), y down; outside the
+/// image is background.
+struct Contours2D {
+  int64_t width = 0, height = 0;
+  std::vector<uint8_t> inside;                 ///< width * height, row-major
+  // One vertex per stick (an edge between two differing pixels, the image
+  // padded by one background pixel); vertex v at lower + t * e_axis.
+  std::vector<std::array<int64_t, 2>> lower;
+  std::vector<uint8_t> axis;                   ///< 0: along x, 1: along y
+  std::vector<double> t;
+  std::vector<uint32_t> ids, offsets;          ///< closed curves (CSR), inside on the left
+  std::array<double, 2> position(size_t v) const;
+};
+
+/// Marching-squares contours of a binary image (square_case: the same rule as 3D).
+Contours2D extract_contours(int64_t width, int64_t height, std::vector<uint8_t> inside);
+/// Presses the contours in place (each vertex lies on one curve only).
+PressStats press(Contours2D& contours, const PressOptions& options = {});
+
+}  // namespace voxpress

@@ -1,0 +1,505 @@
+// Pressing: constrained bilaplacian smoothing on axis slices (Chica et al.,
+// Section 4). Theory of operation: see include/voxpress/smooth/pressing.h.
+//
+// Data layout. The iteration renumbers the vertices in 8^3-brick Morton
+// order (so that the curves of one plane touch a small working set) and
+// works per plane family in the plane's 2D index coordinates: curve-vertex
+// k of a family sits at base[k] + t[ids[k]] * e_mov[k]; only t is gathered
+// per iteration (with software prefetch, as the curve order is not the
+// vertex order). A vertex's two proposals live in prop[2 v + slot], slot 0
+// for the lower of its two plane families, and the family writes them through
+// a precomputed index dst[k]. Frozen vertices are simply skipped by the
+// update pass: they keep their t, and curves use them as fixed points.
+//
+// Anisotropic or sheared lattices: arc lengths use the plane's metric (the
+// Gram matrix of the two index-to-physical columns), so positions, arc
+// lengths and Laplacians are physical; the Laplacian is linear, so it is the
+// same computed in index coordinates. d is arc_length times the geometric
+// mean of the two cell sides of the curve's plane (the side of the square
+// with the cell's area).
+#include "voxpress/smooth/pressing.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "voxpress/extract/cube_cases.h"
+
+namespace voxpress {
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
+
+// Slot of plane family a among the two families of a stick along axis b.
+inline int slot_of(int a, int b) { return a < 3 - a - b ? 0 : 1; }
+
+// A location on a polyline: point k + f (point k + 1 - point k).
+struct Where {
+  uint32_t k;
+  double f;
+};
+
+// The metric of a plane's index coordinates (u, v): |(du, dv)|^2 =
+// g00 du^2 + 2 g01 du dv + g11 dv^2 in physical units (the Gram matrix of
+// the lattice's two index-to-physical columns spanning the plane).
+struct Metric {
+  double g00, g01, g11;
+  double norm(const Vec2& x) const { return std::sqrt(g00 * x.x() * x.x() + 2 * g01 * x.x() * x.y() + g11 * x.y() * x.y()); }
+  double dot(const Vec2& x, const Vec2& y) const {
+    return g00 * x.x() * y.x() + g01 * (x.x() * y.y() + x.y() * y.x()) + g11 * x.y() * y.y();
+  }
+};
+
+struct Scratch {
+  std::vector<Vec2> pos, lap, disp, tangent;
+  std::vector<double> len, inv;  // segment lengths and their reciprocals
+  std::vector<Where> fwd, bwd;
+  void resize(size_t n) {  // grows only: the kernel uses the first n entries
+    if (pos.size() >= n) return;
+    for (auto* v : {&pos, &lap, &disp, &tangent}) v->resize(n);
+    len.resize(n);
+    inv.resize(n);
+    fwd.resize(n);
+    bwd.resize(n);
+  }
+};
+
+// Displacement proposals s^2 L^2(C) for the n vertices w.pos of one curve
+// (closed, or open with fixed ends), in the plane's index coordinates, and
+// unit tangents (index coordinates, unit in the metric) for the weightings.
+// Section 4, Fig. 4-6: virtual neighbours at arc length d, two Laplacian passes.
+void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool tangents, const Metric& g,
+                Scratch& w) {
+  const Vec2* p = w.pos.data();
+  double* len = w.len.data();
+  Where* fwd = w.fwd.data();
+  Where* bwd = w.bwd.data();
+  Vec2* lap = w.lap.data();
+  const auto next = [n](size_t k) { return k + 1 == n ? size_t(0) : k + 1; };
+  const size_t segs = closed ? n : n - 1;
+  double perimeter = 0;
+  for (size_t i = 0; i < segs; ++i) {
+    perimeter += (len[i] = g.norm(p[next(i)] - p[i]));
+    w.inv[i] = len[i] > 0 ? 1 / len[i] : 0;
+  }
+  if (!(perimeter > 0) || n < 3) {
+    for (size_t i = 0; i < n; ++i) w.disp[i] = w.tangent[i] = Vec2::Zero();
+    return;
+  }
+  // A closed curve shorter than d: wrap d (Fig. 6 on a tiny loop).
+  const double dd = closed && d >= perimeter ? std::fmod(d, perimeter) : d;
+  for (size_t i = 0; i < n; ++i) {
+    if (!resample) {
+      // Plain bilaplacian: the actual neighbours (open ends: themselves).
+      fwd[i] = {uint32_t(closed ? next(i) : std::min(i + 1, n - 1)), 0};
+      bwd[i] = {uint32_t(closed ? (i == 0 ? n - 1 : i - 1) : (i == 0 ? 0 : i - 1)), 0};
+      continue;
+    }
+    // Forward: walk dd along the curve.
+    double r = dd;
+    size_t j = i;
+    for (;;) {
+      if (!closed && j + 1 >= n) {
+        fwd[i] = {uint32_t(n - 1), 0};
+        break;
+      }
+      if (r <= len[j]) {
+        fwd[i] = {uint32_t(j), r * w.inv[j]};
+        break;
+      }
+      r -= len[j];
+      j = next(j);
+    }
+    // Backward.
+    r = dd;
+    j = i;
+    for (;;) {
+      if (!closed && j == 0) {
+        bwd[i] = {0, 0};
+        break;
+      }
+      const size_t k = j == 0 ? n - 1 : j - 1;
+      if (r <= len[k]) {
+        bwd[i] = {uint32_t(k), len[k] > 0 ? 1 - r * w.inv[k] : 0};
+        break;
+      }
+      r -= len[k];
+      j = k;
+    }
+  }
+  const auto point = [&](const Where& x) { return Vec2(p[x.k] + x.f * (p[next(x.k)] - p[x.k])); };
+  // Pass 1: Laplacian towards the virtual neighbours.
+  for (size_t i = 0; i < n; ++i) {
+    const Vec2 f = point(fwd[i]), b = point(bwd[i]);
+    lap[i] = 0.5 * (f + b) - p[i];
+    if (tangents) {
+      const Vec2 tg = f - b;
+      const double l = g.norm(tg);
+      w.tangent[i] = l > 0 ? Vec2(tg / l) : Vec2::Zero();
+    }
+  }
+  // Pass 2: the Laplacian of the Laplacian, interpolated at the same places.
+  const auto lap_at = [&](const Where& x) { return Vec2(lap[x.k] + x.f * (lap[next(x.k)] - lap[x.k])); };
+  for (size_t i = 0; i < n; ++i) w.disp[i] = s2 * (lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+SliceCurves build_slice_curves(const StickSurface& s) {
+  const size_t n = s.stick_count();
+  std::vector<std::array<int64_t, 3>> lo(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) { lo[i] = s.lower_index(i); });
+  // Two neighbours per stick and plane slot.
+  std::vector<uint32_t> nb(4 * n, kNone);
+  auto link = [&](uint32_t u, uint32_t v, int slot) {
+    uint32_t* x = &nb[4 * size_t(u) + 2 * size_t(slot)];
+    if (x[0] == v || x[1] == v) return;
+    if (x[0] == kNone)
+      x[0] = v;
+    else if (x[1] == kNone)
+      x[1] = v;
+    else
+      throw std::logic_error("slice curves: a stick has more than two neighbours in a plane");
+  };
+  for (const Triangle& t : s.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t u = t[size_t(e)], v = t[size_t((e + 1) % 3)];
+      const int au = s.axis(u), av = s.axis(v);
+      for (int a = 0; a < 3; ++a)
+        if (a != au && a != av && lo[u][size_t(a)] == lo[v][size_t(a)]) {
+          link(u, v, slot_of(a, au));
+          link(v, u, slot_of(a, av));
+          break;
+        }
+    }
+  SliceCurves c;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<uint8_t> seen(n, 0);
+    struct Curve {
+      int64_t plane;
+      uint32_t begin, size;
+    };
+    std::vector<Curve> curves;
+    std::vector<uint32_t> ids;
+    for (uint32_t s0 = 0; s0 < n; ++s0) {
+      if (s.axis(s0) == a || seen[s0]) continue;
+      const uint32_t begin = uint32_t(ids.size());
+      uint32_t prev = kNone, cur = s0;
+      do {
+        seen[cur] = 1;
+        ids.push_back(cur);
+        const uint32_t* x = &nb[4 * size_t(cur) + 2 * size_t(slot_of(a, s.axis(cur)))];
+        if (x[0] == kNone || x[1] == kNone)
+          throw std::logic_error("slice curves: a stick lacks a neighbour in a plane (open cut)");
+        const uint32_t next = x[0] != prev ? x[0] : x[1];
+        prev = cur;
+        cur = next;
+      } while (cur != s0);
+      curves.push_back({lo[s0][size_t(a)], begin, uint32_t(ids.size()) - begin});
+    }
+    std::stable_sort(curves.begin(), curves.end(), [](const Curve& x, const Curve& y) { return x.plane < y.plane; });
+    c.offsets[a].push_back(0);
+    for (const Curve& cv : curves) {
+      c.ids[a].insert(c.ids[a].end(), ids.begin() + cv.begin, ids.begin() + cv.begin + cv.size);
+      c.offsets[a].push_back(uint32_t(c.ids[a].size()));
+    }
+  }
+  return c;
+}
+
+namespace {
+
+// The shared iteration over vertices on sticks, t[i] in [0, 1], grouped in
+// curve families (a 3D plane family, or the one 2D family). Each vertex lies
+// on `per_vertex` curves (2 in 3D, 1 in 2D), so it has per_vertex proposal
+// slots; a family's curve-vertex k writes its proposal into slot dst[k].
+//
+// A family works in its plane's 2D index coordinates (u, v) with the plane's
+// metric: curve-vertex k (in ids order) sits at base[k] + t * e_mov[k], where
+// base is the stick's lower sample and mov which of u, v the stick runs
+// along. Only t is gathered per iteration; positions, arc lengths and the
+// bilaplacian are computed in 2D, and the displacement D = (du, dv) projects
+// onto the stick's physical line as dt = <D, e_mov>_g / <e_mov, e_mov>_g.
+struct Family {
+  const std::vector<uint32_t>* ids;
+  const std::vector<uint32_t>* offsets;
+  std::vector<Vec2> base;
+  std::vector<uint8_t> mov;
+  std::vector<uint32_t> dst;  // per curve-vertex: its proposal's index, per_vertex * id + slot
+  Metric g;
+  double cell;  // cell side of the family's planes (d = arc_length * cell)
+};
+
+PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
+                   const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier, const PressOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t n = t.size();
+  PressStats st;
+  for (const Family& f : families) st.curves += f.offsets->size() - 1;
+  for (uint8_t x : frozen) st.frozen += x != 0;
+  st.fresh = n - st.frozen;
+  if (n == 0) return st;
+  const double s2 = o.step * o.step;
+  const int levels = std::max(1, o.levels);
+  const bool weighted = o.weighting != PressOptions::Weighting::equal;
+  std::vector<double> prop(size_t(per_vertex) * n, 0), weight(weighted ? size_t(per_vertex) * n : 0, 0);
+  std::vector<double> velocity(o.momentum != 0 ? n : 0, 0.0);
+  ProgressCounter progress(o.progress, "pressing", uint64_t(std::max(o.iterations, 0)));
+  for (int it = 0; it < o.iterations; ++it) {
+    // Stage of the coarse-to-fine schedule: d * 2^(levels - 1 - stage).
+    const int stage = std::min(levels - 1, it * levels / std::max(o.iterations, 1));
+    const double scale = double(1 << (levels - 1 - stage));
+    for (const Family& fam : families) {
+      const uint32_t* ids = fam.ids->data();
+      const auto& off = *fam.offsets;
+      const size_t total = fam.ids->size();
+      const Metric& g = fam.g;
+      // dt per unit displacement along u and v, for a stick along u (row 0) or v (row 1).
+      const double proj[2][2] = {{1, g.g01 / g.g00}, {g.g01 / g.g11, 1}};
+      const double d = o.arc_length * scale * fam.cell;
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, off.size() - 1, 32), [&](const tbb::blocked_range<size_t>& r) {
+        Scratch w;
+        for (size_t c = r.begin(); c < r.end(); ++c) {
+          const uint32_t b = off[c], m = off[c + 1] - b;
+          // The curve, or its open pieces between barrier vertices, each
+          // piece starting and ending at a barrier (cyclically).
+          uint32_t first_barrier = m;
+          if (!barrier.empty())
+            for (uint32_t i = 0; i < m && first_barrier == m; ++i)
+              if (barrier[ids[b + i]]) first_barrier = i;
+          auto emit = [&](uint32_t k, const Vec2& disp, const Vec2& tangent) {  // k: curve-vertex index
+            const int mv = fam.mov[k];
+            const uint32_t q = fam.dst[k];
+            prop[q] = proj[mv][0] * disp.x() + proj[mv][1] * disp.y();
+            if (weighted) {
+              // |cos| between the stick and the curve tangent, both unit in the metric.
+              const Vec2 e = mv == 0 ? Vec2(1 / std::sqrt(g.g00), 0) : Vec2(0, 1 / std::sqrt(g.g11));
+              const double cs = std::min(1.0, std::abs(g.dot(e, tangent)));
+              weight[q] = o.weighting == PressOptions::Weighting::tangent ? cs : std::sqrt(1 - cs * cs);
+            }
+          };
+          auto gather = [&](uint32_t i, uint32_t k) {
+            // The curve-vertex order is not the vertex order: prefetch the
+            // gathered t and the scattered proposal a little ahead.
+            if (k + kAhead < total) {
+              __builtin_prefetch(&t[ids[k + kAhead]]);
+              __builtin_prefetch(&prop[fam.dst[k + kAhead]], 1);
+            }
+            const double tk = t[ids[k]], mv = double(fam.mov[k]);
+            w.pos[i] = Vec2(fam.base[k].x() + (1 - mv) * tk, fam.base[k].y() + mv * tk);
+          };
+          if (first_barrier == m) {
+            w.resize(m);
+            for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
+            curve_step(m, true, d, s2, o.resample, weighted, g, w);
+            for (uint32_t i = 0; i < m; ++i) emit(b + i, w.disp[i], w.tangent[i]);
+            continue;
+          }
+          // Open pieces from barrier to barrier; the barrier ends stay fixed.
+          for (uint32_t k = 0; k < m;) {
+            uint32_t len = 1;
+            while (!barrier[ids[b + (first_barrier + k + len) % m]]) ++len;
+            w.resize(len + 1);
+            for (uint32_t i = 0; i <= len; ++i) gather(i, b + (first_barrier + k + i) % m);
+            curve_step(len + 1, false, d, s2, o.resample, weighted, g, w);
+            for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, w.disp[i], w.tangent[i]);
+            k += len;
+          }
+        }
+      });
+    }
+    const double max_change = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, n, 1 << 14), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double acc) {
+          for (size_t i = r.begin(); i < r.end(); ++i) {
+            if (!frozen.empty() && frozen[i]) continue;
+            const double* p = &prop[size_t(per_vertex) * i];
+            double dt;
+            if (per_vertex == 1) {
+              dt = p[0];
+            } else if (weighted) {
+              const double w0 = weight[2 * i], w1 = weight[2 * i + 1];
+              dt = w0 + w1 > 0 ? (w0 * p[0] + w1 * p[1]) / (w0 + w1) : 0;
+            } else {
+              dt = 0.5 * (p[0] + p[1]);
+            }
+            if (!velocity.empty()) dt += o.momentum * velocity[i];
+            const double t_new = std::clamp(t[i] + dt, o.margin, 1 - o.margin);
+            acc = std::max(acc, std::abs(t_new - t[i]));
+            if (!velocity.empty()) velocity[i] = t_new - t[i];
+            t[i] = t_new;
+          }
+          return acc;
+        },
+        [](double x, double y) { return std::max(x, y); });
+    st.iterations = it + 1;
+    st.last_max_change = max_change;
+    progress.add(1);
+    if (max_change < o.tolerance) break;
+  }
+  st.seconds = seconds_since(t0);
+  return st;
+}
+
+}  // namespace
+
+PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions& o, const std::vector<uint8_t>& frozen,
+                 const std::vector<uint8_t>& barrier) {
+  const size_t n = s.stick_count();
+  if (!frozen.empty() && frozen.size() != n) throw std::invalid_argument("press: frozen flags do not match the sticks");
+  if (!barrier.empty() && barrier.size() != n) throw std::invalid_argument("press: barrier flags do not match the sticks");
+  for (size_t i = 0; i < barrier.size(); ++i)
+    if (barrier[i] && (frozen.empty() || !frozen[i])) throw std::invalid_argument("press: a barrier vertex must be frozen");
+  // Renumber the vertices in 8^3-brick Morton order for the iteration. The
+  // canonical (row) order puts consecutive vertices of an x-plane curve a
+  // whole row apart, so every access misses the cache; in brick order a
+  // plane's curves touch a few hundred KiB, reused by the next plane.
+  // Keys are unique, so the order (and the result) is deterministic.
+  std::vector<std::pair<uint64_t, uint32_t>> sorted(n);  // (brick Morton code, canonical id)
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    const auto l = s.lower_index(i);
+    uint64_t m = 0;
+    for (int b = 0; b < 16; ++b)
+      for (int a = 0; a < 3; ++a) m |= ((uint64_t(l[size_t(a)] + 1) >> (3 + b)) & 1) << (3 * b + a);
+    sorted[i] = {m, uint32_t(i)};
+  });
+  tbb::parallel_sort(sorted.begin(), sorted.end());
+  std::vector<uint32_t> old_of(n), new_of(n);
+  std::vector<double> t(n);
+  std::vector<uint8_t> fz(frozen.empty() ? 0 : n), br(barrier.empty() ? 0 : n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    const uint32_t old = sorted[i].second;
+    old_of[i] = old;
+    new_of[old] = uint32_t(i);
+    t[i] = s.t[old];
+    if (!fz.empty()) fz[i] = frozen[old];
+    if (!br.empty()) br[i] = barrier[old];
+  });
+  const Mat3 M = s.lattice.index_to_physical_matrix();
+  std::vector<Family> families(3);
+  std::vector<uint32_t> ids[3];
+  for (int a = 0; a < 3; ++a) {
+    const int u = (a + 1) % 3, v = (a + 2) % 3;
+    Family& f = families[size_t(a)];
+    const size_t m = curves.ids[a].size();
+    ids[a].resize(m);
+    f.ids = &ids[a];
+    f.offsets = &curves.offsets[a];
+    f.g = {M.col(u).squaredNorm(), M.col(u).dot(M.col(v)), M.col(v).squaredNorm()};
+    f.cell = std::sqrt(s.lattice.spacing[u] * s.lattice.spacing[v]);
+    f.base.resize(m);
+    f.mov.resize(m);
+    f.dst.resize(m);
+    tbb::parallel_for(size_t(0), m, [&](size_t k) {
+      const uint32_t id = curves.ids[a][k];
+      const auto l = s.lower_index(id);
+      ids[a][k] = new_of[id];
+      f.base[k] = Vec2(double(l[size_t(u)]), double(l[size_t(v)]));
+      f.mov[k] = uint8_t(s.axis(id) == u ? 0 : 1);
+      f.dst[k] = 2 * new_of[id] + uint32_t(slot_of(a, s.axis(id)));
+    });
+  }
+  const PressStats st = iterate(t, families, 2, fz, br, o);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[old_of[i]] = t[i]; });
+  return st;
+}
+
+PressStats press(StickSurface& surface, const PressOptions& options) {
+  return press(surface, build_slice_curves(surface), options);
+}
+
+// --------------------------------------------------------------------- 2D
+std::array<double, 2> Contours2D::position(size_t v) const {
+  std::array<double, 2> p{double(lower[v][0]), double(lower[v][1])};
+  p[axis[v]] += t[v];
+  return p;
+}
+
+Contours2D extract_contours(int64_t w, int64_t h, std::vector<uint8_t> inside) {
+  if (w < 1 || h < 1 || inside.size() != size_t(w * h)) throw std::invalid_argument("extract_contours: bad image");
+  Contours2D c;
+  c.width = w;
+  c.height = h;
+  c.inside = std::move(inside);
+  auto at = [&](int64_t x, int64_t y) { return x >= 0 && y >= 0 && x < w && y < h && c.inside[size_t(y * w + x)]; };
+  // Stick ids: x-sticks (x, y)-(x+1, y) for x in [-1, w-1], y in [0, h-1];
+  // y-sticks (x, y)-(x, y+1) for x in [0, w-1], y in [-1, h-1].
+  std::vector<uint32_t> xid(size_t((w + 1) * h), kNone), yid(size_t(w * (h + 1)), kNone);
+  for (int64_t y = -1; y <= h; ++y)
+    for (int64_t x = -1; x <= w; ++x) {
+      if (y >= 0 && y < h && x < w && at(x, y) != at(x + 1, y)) {
+        xid[size_t(y * (w + 1) + x + 1)] = uint32_t(c.lower.size());
+        c.lower.push_back({x, y});
+        c.axis.push_back(0);
+      }
+      if (x >= 0 && x < w && y < h && at(x, y) != at(x, y + 1)) {
+        yid[size_t((y + 1) * w + x)] = uint32_t(c.lower.size());
+        c.lower.push_back({x, y});
+        c.axis.push_back(1);
+      }
+    }
+  c.t.assign(c.lower.size(), 0.5);
+  std::vector<uint32_t> next(c.lower.size(), kNone);
+  for (int64_t y = -1; y < h; ++y)
+    for (int64_t x = -1; x < w; ++x) {
+      const bool q[4] = {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)};
+      unsigned mask = 0;
+      for (int k = 0; k < 4; ++k) mask |= unsigned(q[k]) << k;
+      const SquareCase& sc = square_case(mask);
+      auto edge = [&](int e) -> uint32_t {  // square edge e joins corners e and e + 1
+        switch (e) {
+          case 0: return xid[size_t(y * (w + 1) + x + 1)];
+          case 1: return yid[size_t((y + 1) * w + x + 1)];
+          case 2: return xid[size_t((y + 1) * (w + 1) + x + 1)];
+          default: return yid[size_t((y + 1) * w + x)];
+        }
+      };
+      for (int k = 0; k < sc.count; ++k) next[edge(sc.segments[size_t(k)][0])] = edge(sc.segments[size_t(k)][1]);
+    }
+  std::vector<uint8_t> seen(c.lower.size(), 0);
+  c.offsets.push_back(0);
+  for (uint32_t v0 = 0; v0 < c.lower.size(); ++v0) {
+    if (seen[v0]) continue;
+    uint32_t v = v0;
+    do {
+      if (v == kNone) throw std::logic_error("extract_contours: open contour");
+      seen[v] = 1;
+      c.ids.push_back(v);
+      v = next[v];
+    } while (v != v0);
+    c.offsets.push_back(uint32_t(c.ids.size()));
+  }
+  return c;
+}
+
+PressStats press(Contours2D& c, const PressOptions& o) {
+  std::vector<Family> families(1);
+  Family& f = families[0];
+  f.ids = &c.ids;
+  f.offsets = &c.offsets;
+  f.g = {1, 0, 1};
+  f.cell = 1;
+  f.base.resize(c.ids.size());
+  f.mov.resize(c.ids.size());
+  f.dst = c.ids;
+  for (size_t k = 0; k < c.ids.size(); ++k) {
+    const uint32_t v = c.ids[k];
+    f.base[k] = Vec2(double(c.lower[v][0]), double(c.lower[v][1]));
+    f.mov[k] = c.axis[v];
+  }
+  return iterate(c.t, families, 1, {}, {}, o);
+}
+
+}  // namespace voxpress
