@@ -23,17 +23,7 @@ void run_extract(const ExtractCmd& c, const Global& g) {
   const StickSurface surface = extract_sticks(volume, eo, &st);
   const Mesh mesh = to_mesh(surface);
   const double t_extract = clock.seconds();
-  nlohmann::json checks;
-  if (c.check) {
-    const MeshCheck mc = check_mesh(mesh);
-    ClassificationOptions co;
-    co.progress = bar.get();
-    const ClassificationReport cr = check_classification(mesh, volume, co);
-    checks = {{"mesh_ok", mc.ok()}, {"problems", mc.problems}, {"classification_violations", cr.violations}};
-    if (!mc.ok() || cr.violations)
-      throw Error("the extracted surface failed its checks: " +
-                  (mc.problems.empty() ? std::to_string(cr.violations) + " classification violations" : mc.problems[0]));
-  }
+  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), "extracted") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);

@@ -6,26 +6,21 @@ namespace voxpress::cli {
 namespace {
 
 struct GenerateCmd {
-  std::string shape, output, rotate = "none", spacing = "1,1,1", stats_json;
-  int64_t res = 64, margin = 2;
+  std::string shape, output, stats_json;
+  PlacementCli place{64};
 };
 
 void run_generate(const GenerateCmd& c, const Global& g) {
   Stopwatch clock;
   const ShapeKind kind = parse_shape(c.shape);
   GenerateOptions o;
-  o.res = c.res;
-  o.margin = c.margin;
-  o.rotation = parse_rotation(c.rotate);
-  o.spacing = parse_vec3(c.spacing, "--spacing");
-  o.max_bytes = g.memory_limit();
   ProgressBar bar(!g.quiet);
-  o.progress = bar.get();
+  c.place.apply(o, g, bar.get());
   const GeneratedShape s = generate_shape(kind, o);
   ScalarVolume v = to_scalar(s.volume);
   v.metadata[kShapeKey] = shape_name(kind);
   v.metadata[kModelToPhysicalKey] = format_transform(s.linear, s.translation);
-  v.metadata["voxpress_rotate"] = c.rotate;
+  v.metadata["voxpress_rotate"] = c.place.rotate;
   write_volume(c.output, v);
   if (!c.stats_json.empty()) {
     nlohmann::json j;
@@ -46,10 +41,7 @@ void register_generate(CLI::App& app, Global& g) {
   auto* cmd = app.add_subcommand("generate", "Sample an analytic solid exactly onto a lattice (writes a volume)");
   cmd->add_option("shape", c->shape, "sphere | torus | box | cylinder | cad-part")->required();
   cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif)")->required();
-  cmd->add_option("--res", c->res, "Samples along the physically longest side")->capture_default_str();
-  cmd->add_option("--rotate", c->rotate, "random:SEED, AX,AY,AZ in degrees, or none")->capture_default_str();
-  cmd->add_option("--spacing", c->spacing, "Cell size SX,SY,SZ (anisotropic lattices)")->capture_default_str();
-  cmd->add_option("--margin", c->margin, "Outside samples around the shape")->capture_default_str();
+  c->place.bind(*cmd, "shape");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");
   cmd->callback([c, &g] {
     g.apply();

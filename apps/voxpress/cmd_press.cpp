@@ -30,17 +30,7 @@ void run_press(const PressCmd& c, const Global& g) {
   o.progress = bar.get();
   const PressStats ps = press(surface, o);
   const Mesh mesh = to_mesh(surface);
-  nlohmann::json checks;
-  if (c.check) {
-    const MeshCheck mc = check_mesh(mesh);
-    ClassificationOptions co;
-    co.progress = bar.get();
-    const ClassificationReport cr = check_classification(mesh, volume, co);
-    checks = {{"mesh_ok", mc.ok()}, {"problems", mc.problems}, {"classification_violations", cr.violations}};
-    if (!mc.ok() || cr.violations)
-      throw Error("the pressed surface failed its checks: " +
-                  (mc.problems.empty() ? std::to_string(cr.violations) + " classification violations" : mc.problems[0]));
-  }
+  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), "pressed") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);

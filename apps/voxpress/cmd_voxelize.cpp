@@ -9,26 +9,21 @@ namespace voxpress::cli {
 namespace {
 
 struct VoxelizeCmd {
-  std::string model, output, rotate = "none", spacing = "1,1,1", stats_json;
-  int64_t res = 128, margin = 2;
+  std::string model, output, stats_json;
+  PlacementCli place{128};
 };
 
 void run_voxelize(const VoxelizeCmd& c, const Global& g) {
   Stopwatch clock;
   const Mesh model = read_mesh(c.model, {g.memory_limit()});
   VoxelizeOptions o;
-  o.res = c.res;
-  o.margin = c.margin;
-  o.rotation = parse_rotation(c.rotate);
-  o.spacing = parse_vec3(c.spacing, "--spacing");
-  o.max_bytes = g.memory_limit();
   ProgressBar bar(!g.quiet);
-  o.progress = bar.get();
+  c.place.apply(o, g, bar.get());
   const Voxelized v = voxelize(model, o, c.model);
   ScalarVolume out = to_scalar(v.volume);
   out.metadata[kTruthMeshKey] = std::filesystem::absolute(c.model).lexically_normal().string();
   out.metadata[kModelToPhysicalKey] = format_transform(v.placement.linear, v.placement.translation);
-  out.metadata["voxpress_rotate"] = c.rotate;
+  out.metadata["voxpress_rotate"] = c.place.rotate;
   write_volume(c.output, out);
   if (!c.stats_json.empty()) {
     nlohmann::json j;
@@ -52,10 +47,7 @@ void register_voxelize(CLI::App& app, Global& g) {
                                              "remembers its model and placement, for `voxpress eval`)");
   cmd->add_option("model", c->model, "Closed triangle mesh (.off .obj .stl .ply)")->required();
   cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif)")->required();
-  cmd->add_option("--res", c->res, "Samples along the physically longest side")->capture_default_str();
-  cmd->add_option("--rotate", c->rotate, "random:SEED, AX,AY,AZ in degrees, or none")->capture_default_str();
-  cmd->add_option("--spacing", c->spacing, "Cell size SX,SY,SZ (anisotropic lattices)")->capture_default_str();
-  cmd->add_option("--margin", c->margin, "Outside samples around the model")->capture_default_str();
+  c->place.bind(*cmd, "model");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");
   cmd->callback([c, &g] {
     g.apply();

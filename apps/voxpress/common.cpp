@@ -156,6 +156,24 @@ nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
           {"step", o.step},                 {"resample", o.resample}};
 }
 
+nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what) {
+  const MeshCheck mc = check_mesh(mesh);
+  ClassificationOptions co;
+  co.progress = progress;
+  const ClassificationReport cr = check_classification(mesh, volume, co);
+  if (!mc.ok() || cr.violations)
+    throw Error("the " + what + " surface failed its checks: " +
+                (mc.problems.empty() ? std::to_string(cr.violations) + " classification violations" : mc.problems[0]));
+  return {{"mesh_ok", mc.ok()}, {"problems", mc.problems}, {"classification_violations", cr.violations}};
+}
+
+void PlacementCli::bind(CLI::App& cmd, const std::string& what) {
+  cmd.add_option("--res", res, "Samples along the physically longest side")->capture_default_str();
+  cmd.add_option("--rotate", rotate, "random:SEED, AX,AY,AZ in degrees, or none")->capture_default_str();
+  cmd.add_option("--spacing", spacing, "Cell size SX,SY,SZ (anisotropic lattices)")->capture_default_str();
+  cmd.add_option("--margin", margin, "Outside samples around the " + what)->capture_default_str();
+}
+
 nlohmann::json lattice_json(const Lattice& l) {
   nlohmann::json j;
   j["dims"] = {l.dims[0], l.dims[1], l.dims[2]};

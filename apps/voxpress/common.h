@@ -62,6 +62,9 @@ ScalarVolume load_volume(const std::string& path, const InputOptions& in, const 
 /// Reads, binarises and checks that the volume is neither empty nor full.
 BinaryVolume load_binary(const std::string& path, const InputOptions& in, const Global& g);
 
+/// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).
+Vec3 parse_vec3(const std::string& text, const std::string& option);
+
 /// The smoothing options of `press` and `press2d`.
 struct PressCli {
   PressOptions options;
@@ -72,6 +75,31 @@ struct PressCli {
   PressOptions resolve() const;
 };
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o);
+
+/// `--check` of extract and press: check_mesh and the classification against
+/// the volume, before anything is written. Throws Error ("the <what> surface
+/// failed its checks: ...") on a failure; returns the "checks" object for
+/// --stats-json.
+nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what);
+
+/// --res --rotate --spacing --margin: how generate and voxelize place a solid
+/// on a new lattice (GenerateOptions and VoxelizeOptions share these fields).
+struct PlacementCli {
+  std::string rotate = "none", spacing = "1,1,1";
+  int64_t res, margin = 2;
+  explicit PlacementCli(int64_t default_res) : res(default_res) {}
+  /// `what` names the solid in the help ("shape", "model").
+  void bind(CLI::App& cmd, const std::string& what);
+  template <class Options>
+  void apply(Options& o, const Global& g, Progress* progress) const {
+    o.res = res;
+    o.margin = margin;
+    o.rotation = parse_rotation(rotate);
+    o.spacing = parse_vec3(spacing, "--spacing");
+    o.max_bytes = g.memory_limit();
+    o.progress = progress;
+  }
+};
 
 /// Wall-clock stopwatch for --stats-json.
 class Stopwatch {
@@ -88,8 +116,6 @@ void write_json(const std::string& path, const nlohmann::json& j);
 /// Peak resident memory of this process so far (VmHWM), in bytes.
 uint64_t peak_rss_bytes();
 
-/// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).
-Vec3 parse_vec3(const std::string& text, const std::string& option);
 
 // Subcommand registration (one file each).
 void register_info(CLI::App& app, Global& g);
