@@ -28,6 +28,9 @@ class TempDir {
   std::filesystem::path dir_;
 };
 
+/// The bytes of a file ("" if it cannot be read).
+std::string read_file(const std::string& path);
+
 /// ../shared/data next to the repository, or "" when absent.
 std::string shared_data();
 /// Skips the current test with a message when ../shared/data is absent.

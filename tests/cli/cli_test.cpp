@@ -70,8 +70,7 @@ TEST(Cli, GenerateInfoExtractCheckPipeline) {
   // Thread count does not change the output bytes.
   ASSERT_EQ(run_cli("-q --threads 1 extract " + tmp.path("t.nrrd") + " -o " + tmp.path("one.ply")), 0);
   ASSERT_EQ(run_cli("-q --threads 2 extract " + tmp.path("t.nrrd") + " -o " + tmp.path("two.ply")), 0);
-  std::ifstream a(tmp.path("one.ply"), std::ios::binary), b(tmp.path("two.ply"), std::ios::binary);
-  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(a), {}), std::string(std::istreambuf_iterator<char>(b), {}));
+  EXPECT_EQ(test::read_file(tmp.path("one.ply")), test::read_file(tmp.path("two.ply")));
 }
 
 TEST(Cli, LabelsThresholdsAndRawInputs) {
@@ -236,11 +235,6 @@ TEST(Cli, SharedLabelMapsPerLabel) {
   EXPECT_NE(out.find("4242"), std::string::npos);
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 TEST(Cli, PressSmoothsAndKeepsEverySampleOnItsSide) {
   test::TempDir tmp;
   std::string out;
@@ -279,8 +273,8 @@ TEST(Cli, PressSmoothsAndKeepsEverySampleOnItsSide) {
             st["pressing"]["iterations"].get<int>());
   ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("one.ply") + " --threads 1", &out), 0);
   ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("two.ply") + " --threads 2", &out), 0);
-  EXPECT_EQ(slurp(tmp.path("one.ply")), slurp(tmp.path("two.ply")));
-  EXPECT_EQ(slurp(tmp.path("one.ply")), slurp(tmp.path("p.ply")));
+  EXPECT_EQ(test::read_file(tmp.path("one.ply")), test::read_file(tmp.path("two.ply")));
+  EXPECT_EQ(test::read_file(tmp.path("one.ply")), test::read_file(tmp.path("p.ply")));
   ASSERT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("w.obj") + " --weighting tangent --plain "
                     "--iterations 20",
                     &out),
@@ -316,7 +310,7 @@ TEST(Cli, Press2dWritesContoursOverThePixels) {
                     &out),
             0)
       << out;
-  const std::string svg = slurp(tmp.path("ring.svg"));
+  const std::string svg = test::read_file(tmp.path("ring.svg"));
   EXPECT_NE(svg.find("<image"), std::string::npos);
   size_t closes = 0;  // "Z " ends a contour in a path (base64 pixel data has no spaces)
   for (size_t at = svg.find("Z "); at != std::string::npos; at = svg.find("Z ", at + 1)) ++closes;
@@ -331,7 +325,7 @@ TEST(Cli, Press2dWritesContoursOverThePixels) {
             0)
       << out;
   EXPECT_EQ(nlohmann::json::parse(std::ifstream(tmp.path("i.json")))["pressing"]["curves"], 3);
-  EXPECT_EQ(slurp(tmp.path("inv.svg")).find("<image"), std::string::npos);
+  EXPECT_EQ(test::read_file(tmp.path("inv.svg")).find("<image"), std::string::npos);
   // Bad inputs: one line naming the file, exit 1, nothing written; bad usage: exit 2.
   std::ofstream(tmp.path("white.pgm"), std::ios::binary) << "P5\n4 4\n255\n" << std::string(16, char(255));
   std::ofstream(tmp.path("cut.pgm"), std::ios::binary) << pgm.substr(0, pgm.size() / 2);

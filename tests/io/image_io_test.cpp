@@ -27,11 +27,6 @@ void write_bytes(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 TEST(ImageIo, PngAndNetpbmVariantsReadTheSamePicture) {
   test::TempDir tmp;
   const int w = 23, h = 17;
@@ -84,7 +79,7 @@ TEST(ImageIo, BadImagesNameTheFileAndTheProblem) {
   const auto g = picture(40, 30);
   std::vector<uint8_t> rgba(g.size() * 4, 255);
   write_png(tmp.path("ok.png"), 40, 30, rgba);
-  const std::string png = slurp(tmp.path("ok.png"));
+  const std::string png = test::read_file(tmp.path("ok.png"));
   write_bytes(tmp.path("trunc.png"), png.substr(0, png.size() / 2));
   write_bytes(tmp.path("notpng.png"), "hello, this is not a PNG");
   write_bytes(tmp.path("trunc.pgm"), "P5\n40 30\n255\n" + std::string(100, 'x'));
@@ -123,7 +118,7 @@ TEST(ImageIo, SvgHoldsEveryContourVertex) {
   SvgOptions o;
   o.midpoint = true;
   write_contours_svg(tmp.path("c.svg"), pressed, &mid, o);
-  const std::string svg = slurp(tmp.path("c.svg"));
+  const std::string svg = test::read_file(tmp.path("c.svg"));
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
@@ -147,7 +142,7 @@ TEST(ImageIo, SvgHoldsEveryContourVertex) {
   EXPECT_NEAR(y, p[1] + 0.5, 1e-6);
   o.pixels = false;
   write_contours_svg(tmp.path("bare.svg"), pressed, &mid, o);
-  EXPECT_EQ(slurp(tmp.path("bare.svg")).find("<image"), std::string::npos);
+  EXPECT_EQ(test::read_file(tmp.path("bare.svg")).find("<image"), std::string::npos);
 }
 
 }  // namespace
