@@ -41,6 +41,7 @@ struct Method {
 // Methods join this list as they land.
 const std::vector<Method> kMethods = {
     {"midpoint", {"extract", "IN", "-o", "OUT"}},
+    {"pressing, no flats", {"press", "IN", "-o", "OUT", "--no-flats"}},
     {"pressing", {"press", "IN", "-o", "OUT"}},
 };
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # scripts/demo.sh — sets everything up and runs the main job on a built-in
 # example: a randomly rotated CAD-like part, sampled exactly at 128^3, turned
-# into its midpoint (stick) surface and its Pressing surface, both checked and
+# into its midpoint (stick) surface and its Pressing surface (flats found by
+# plane voting and frozen on their planes; also without flats), checked and
 # evaluated against the exact part; a binary image's contours pressed in 2D.
 # Outputs go to out/demo/. No download, no ../shared.
 set -euo pipefail
@@ -14,12 +15,14 @@ echo "== voxpress demo: a rotated CAD-like part at 128^3"
 "$vp" generate cad-part --res 128 --rotate random:7 -o "$out/part.nrrd"
 "$vp" info "$out/part.nrrd"
 "$vp" extract "$out/part.nrrd" -o "$out/part-midpoint.ply"
-"$vp" press "$out/part.nrrd" -o "$out/part-pressed.ply" --stats-json "$out/press.json"
+"$vp" press "$out/part.nrrd" -o "$out/part-pressed.ply" --color-regions --stats-json "$out/press.json"
+"$vp" -q press "$out/part.nrrd" -o "$out/part-noflats.ply" --no-flats
 "$vp" -q press "$out/part.nrrd" -o "$out/part-pressed.glb"
 "$vp" check "$out/part-pressed.ply" --volume "$out/part.nrrd"
-echo "== distance to the exact part: midpoint surface, then Pressing"
+echo "== distance to the exact part: midpoint surface, Pressing without flats, Pressing"
 "$vp" eval "$out/part-midpoint.ply" --volume "$out/part.nrrd" --samples 100000 --json "$out/eval-midpoint.json"
+"$vp" eval "$out/part-noflats.ply" --volume "$out/part.nrrd" --samples 100000 --json "$out/eval-noflats.json"
 "$vp" eval "$out/part-pressed.ply" --volume "$out/part.nrrd" --samples 100000 --json "$out/eval-pressed.json"
 echo "== 2D: the contours of a small binary image, pressed"
 "$vp" press2d "$root/examples/shapes.pbm" -o "$out/shapes.svg" --midpoint
-echo "== wrote $out/: part.nrrd, part-midpoint.ply, part-pressed.ply/.glb, press.json, eval-*.json, shapes.svg"
+echo "== wrote $out/: part.nrrd, part-midpoint.ply, part-noflats.ply, part-pressed.ply/.glb (vertex colours = flats), press.json, eval-*.json, shapes.svg"

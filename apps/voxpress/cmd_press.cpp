@@ -10,12 +10,44 @@ struct PressCmd {
   std::string input, output, stats_json;
   InputOptions in;
   PressCli smooth;
+  FlatOptions flats;
+  bool no_flats = false, color_regions = false;
   bool ascii = false, check = false;
 };
+
+nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
+  nlohmann::json list = nlohmann::json::array();
+  for (size_t i = 0; i < seg.flats.size(); ++i) {
+    const Flat& f = seg.flats[i];
+    list.push_back({{"id", i},
+                    {"normal", {f.normal.x(), f.normal.y(), f.normal.z()}},
+                    {"offset", f.offset},
+                    {"sticks", f.sticks},
+                    {"area", f.area},
+                    {"area_cells", f.area_cells}});
+  }
+  const FlatStats& st = seg.stats;
+  return {{"count", seg.flats.size()},
+          {"flats", list},
+          {"frozen", seg.frozen_count()},
+          {"junctions", st.junctions},
+          {"barriers", st.barriers},
+          {"votes", st.votes},
+          {"voters", st.voters},
+          {"cells", st.cells},
+          {"cells_tried", st.tried},
+          {"min_area_cells", o.min_area},
+          {"junction_angle", o.junction_angle},
+          {"seconds", {{"estimate", st.seconds_estimate}, {"detect", st.seconds_detect}, {"junctions", st.seconds_junctions}}}};
+}
 
 void run_press(const PressCmd& c, const Global& g) {
   mesh_format_from_path(c.output);  // a bad extension fails before any work
   const PressOptions po = c.smooth.resolve();
+  if (!(c.flats.min_area >= 0)) throw UsageError("--min-flat-area must be >= 0");
+  if (!(c.flats.junction_angle >= 0 && c.flats.junction_angle <= 180)) throw UsageError("--junction-angle must be in [0, 180]");
+  if (!(c.flats.tolerance > 0) || !(c.flats.max_bend > 0) || !(c.flats.min_width >= 0))
+    throw UsageError("--flat-tolerance and --flat-bend must be > 0, --flat-width >= 0");
   Stopwatch clock;
   const BinaryVolume volume = load_binary(c.input, c.in, g);
   const double t_read = clock.seconds();
@@ -28,15 +60,22 @@ void run_press(const PressCmd& c, const Global& g) {
   const double t_extract = clock.seconds();
   PressOptions o = po;
   o.progress = bar.get();
-  const PressStats ps = press(surface, o);
-  const Mesh mesh = to_mesh(surface);
+  FlatOptions fo = c.flats;
+  fo.progress = bar.get();
+  FlatSegmentation seg;
+  const SliceCurves curves = build_slice_curves(surface);
+  const FeaturePressStats fs = press_with_flats(surface, curves, o, c.no_flats ? nullptr : &fo, &seg);
+  const PressStats& ps = fs.press;
+  Mesh mesh = to_mesh(surface);
+  if (!c.no_flats) add_region_attributes(mesh, seg, c.color_regions);
   const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), "pressed") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
   if (!g.quiet)
-    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %d iterations (last max change %.2g)\n", c.output.c_str(),
-                 mesh.vertex_count(), mesh.face_count(), ps.iterations, ps.last_max_change);
+    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %d iterations (last max change %.2g)\n",
+                 c.output.c_str(), mesh.vertex_count(), mesh.face_count(), seg.flats.size(), seg.frozen_count(),
+                 size_t(seg.stats.junctions), ps.iterations, ps.last_max_change);
   if (!c.stats_json.empty()) {
     nlohmann::json j;
     j["command"] = "press";
@@ -47,6 +86,7 @@ void run_press(const PressCmd& c, const Global& g) {
     j["counts"] = {{"samples", es.samples}, {"sticks", es.sticks}, {"vertices", mesh.vertex_count()},
                    {"triangles", mesh.face_count()}};
     j["pressing"] = press_stats_json(ps, po);
+    if (!c.no_flats) j["flats"] = flats_json(seg, fo);
     j["seconds"] = {{"read", t_read}, {"extract", t_extract - t_read}, {"press", ps.seconds}, {"total", clock.seconds()}};
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
@@ -64,6 +104,17 @@ void register_press(CLI::App& app, Global& g) {
   cmd->add_option("-o,--output", c->output, "Output mesh (.ply .obj .stl .off .glb .gltf)")->required();
   c->in.bind(*cmd);
   c->smooth.bind(*cmd);
+  auto* f = cmd->add_option_group("flats", "Flats (plane voting) and junctions");
+  f->add_flag("--no-flats", c->no_flats, "Do not look for flats: every vertex is smoothed");
+  f->add_option("--min-flat-area", c->flats.min_area, "Smallest flat, in cell areas")->capture_default_str();
+  f->add_option("--junction-angle", c->flats.junction_angle,
+                "Degrees between a flat and its curved neighbour above which their border is sharp")
+      ->capture_default_str();
+  f->add_option("--flat-tolerance", c->flats.tolerance, "Cells: how close to its plane a flat's surface must be")
+      ->capture_default_str();
+  f->add_option("--flat-bend", c->flats.max_bend, "Degrees: largest normal change across a flat")->capture_default_str();
+  f->add_option("--flat-width", c->flats.min_width, "Cells: narrowest flat")->capture_default_str();
+  f->add_flag("--color-regions", c->color_regions, "Colour the vertices by region (flats, curved grey, junctions orange)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");

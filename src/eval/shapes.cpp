@@ -3,8 +3,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cmath>
+#include <map>
 #include <numbers>
+#include <cmath>
 #include <sstream>
 
 #include "voxpress/core/error.h"
@@ -183,6 +184,89 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
   }
   g.volume.source = std::string("generated ") + shape_name(kind);
   return g;
+}
+
+std::vector<PlanarFace> planar_faces(const Mesh& mesh, double angle_deg, double distance) {
+  const size_t nf = mesh.face_count();
+  std::vector<Vec3> normal(nf);
+  std::vector<double> area(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.triangles[f];
+    const Vec3 c = (mesh.positions[t[1]] - mesh.positions[t[0]]).cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
+    area[f] = c.norm() / 2;
+    normal[f] = area[f] > 0 ? Vec3(c.normalized()) : Vec3::Zero();
+  }
+  // Faces across each edge (a closed manifold mesh has two per edge).
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> edges;
+  for (size_t f = 0; f < nf; ++f)
+    for (int e = 0; e < 3; ++e) {
+      uint32_t a = mesh.triangles[f][size_t(e)], b = mesh.triangles[f][size_t((e + 1) % 3)];
+      if (a > b) std::swap(a, b);
+      edges[{a, b}].push_back(uint32_t(f));
+    }
+  const double cos_tol = std::cos(angle_deg * std::numbers::pi / 180);
+  std::vector<int> group(nf, -1);
+  std::vector<PlanarFace> out;
+  for (size_t f0 = 0; f0 < nf; ++f0) {
+    if (group[f0] >= 0 || area[f0] == 0) continue;
+    const Vec3 n = normal[f0];
+    const double c = n.dot(mesh.positions[mesh.triangles[f0][0]]);
+    const int id = int(out.size());
+    PlanarFace pf{n, c, 0};
+    std::vector<uint32_t> stack{uint32_t(f0)};
+    group[f0] = id;
+    while (!stack.empty()) {
+      const uint32_t f = stack.back();
+      stack.pop_back();
+      pf.area += area[f];
+      for (int e = 0; e < 3; ++e) {
+        uint32_t a = mesh.triangles[f][size_t(e)], b = mesh.triangles[f][size_t((e + 1) % 3)];
+        if (a > b) std::swap(a, b);
+        for (uint32_t g : edges[{a, b}]) {
+          if (group[g] >= 0 || area[g] == 0 || normal[g].dot(n) < cos_tol) continue;
+          bool on = true;
+          for (uint32_t v : mesh.triangles[g]) on &= std::abs(n.dot(mesh.positions[v]) - c) <= distance;
+          if (!on) continue;
+          group[g] = id;
+          stack.push_back(g);
+        }
+      }
+    }
+    out.push_back(pf);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const PlanarFace& a, const PlanarFace& b) { return a.area > b.area; });
+  return out;
+}
+
+std::vector<PlanarFace> shape_planar_faces(ShapeKind kind) {
+  std::vector<PlanarFace> out;
+  switch (kind) {
+    case ShapeKind::box: {
+      const Vec3 h = kBoxHalf;
+      for (int a = 0; a < 3; ++a)
+        for (double s : {1.0, -1.0}) {
+          Vec3 n = Vec3::Zero();
+          n[a] = s;
+          out.push_back({n, h[a], 4 * h[(a + 1) % 3] * h[(a + 2) % 3]});
+        }
+      break;
+    }
+    case ShapeKind::cylinder:
+      for (double s : {1.0, -1.0}) out.push_back({Vec3(0, 0, s), kCylHalf, std::numbers::pi * kCylRadius * kCylRadius});
+      break;
+    case ShapeKind::cad_part:
+      for (const PlanarFace& f : planar_faces(cad_part_mesh()))
+        if (f.area > 1e-3) out.push_back(f);
+      break;
+    default: break;
+  }
+  return out;
+}
+
+PlanarFace transform_face(const PlanarFace& f, const Mat3& linear, const Vec3& translation) {
+  const double scale = std::cbrt(std::abs(linear.determinant()));
+  const Vec3 n = (linear.inverse().transpose() * f.normal).normalized();
+  return {n, scale * f.offset + n.dot(translation), scale * scale * f.area};
 }
 
 }  // namespace voxpress

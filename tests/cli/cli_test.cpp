@@ -293,6 +293,59 @@ TEST(Cli, PressSmoothsAndKeepsEverySampleOnItsSide) {
   EXPECT_EQ(tmp.files(), before);
 }
 
+TEST(Cli, PressFindsFlatsAndWritesRegions) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate box --res 48 --rotate random:4 -o " + tmp.path("b.nrrd"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("b.ply") + " --check --color-regions --stats-json " +
+                        tmp.path("b.json"),
+                    &out),
+            0)
+      << out;
+  const auto st = nlohmann::json::parse(std::ifstream(tmp.path("b.json")));
+  ASSERT_EQ(st["flats"]["count"], 6);
+  ASSERT_EQ(st["flats"]["flats"].size(), 6u);
+  size_t frozen = 0;
+  for (const auto& f : st["flats"]["flats"]) {
+    ASSERT_EQ(f["normal"].size(), 3u);
+    const double len = std::hypot(f["normal"][0].get<double>(), f["normal"][1].get<double>(), f["normal"][2].get<double>());
+    EXPECT_NEAR(len, 1, 1e-9);
+    EXPECT_GT(f["area"].get<double>(), 64);
+    frozen += f["sticks"].get<size_t>();
+    EXPECT_TRUE(f.contains("offset"));
+  }
+  EXPECT_EQ(st["flats"]["frozen"].get<size_t>(), frozen);
+  EXPECT_EQ(st["checks"]["classification_violations"], 0);
+  const Mesh m = read_mesh(tmp.path("b.ply"));
+  const MeshAttribute* region = m.vertex_attribute("region");
+  ASSERT_TRUE(region != nullptr);
+  ASSERT_TRUE(m.vertex_attribute("junction") != nullptr);
+  EXPECT_EQ(m.colors.size(), m.vertex_count());
+  size_t in_flats = 0;
+  for (double r : region->values) {
+    ASSERT_GE(r, -1);
+    ASSERT_LT(r, 6);
+    in_flats += r >= 0;
+  }
+  EXPECT_EQ(in_flats, frozen);
+  // --no-flats: plain Pressing, no regions.
+  ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("n.ply") + " --no-flats --stats-json " +
+                        tmp.path("n.json"),
+                    &out),
+            0);
+  EXPECT_FALSE(nlohmann::json::parse(std::ifstream(tmp.path("n.json"))).contains("flats"));
+  EXPECT_EQ(read_mesh(tmp.path("n.ply")).vertex_attribute("region"), nullptr);
+  // A huge minimum area finds nothing; bad option values are usage errors.
+  ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("m.ply") + " --min-flat-area 100000 --stats-json " +
+                        tmp.path("m.json"),
+                    &out),
+            0);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(tmp.path("m.json")))["flats"]["count"], 0);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --junction-angle 200", &out), 2);
+  EXPECT_NE(out.find("--junction-angle"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
+}
+
 TEST(Cli, Press2dWritesContoursOverThePixels) {
   test::TempDir tmp;
   // A dark ring on white, as binary PGM.

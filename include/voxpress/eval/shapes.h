@@ -44,6 +44,23 @@ bool shape_contains(ShapeKind kind, const Vec3& m);
 /// It *defines* the part: shape_contains and generate_shape use it.
 const Mesh& cad_part_mesh();
 
+/// A planar face of a solid's boundary: the plane normal . x = offset
+/// (normal unit, outward) and the face's area.
+struct PlanarFace {
+  Vec3 normal{0, 0, 1};
+  double offset = 0;
+  double area = 0;
+};
+/// The planar faces of a closed triangle mesh: edge-connected sets of
+/// triangles on one plane (normals within `angle_deg`, offsets within
+/// `distance`), largest first. Finely tessellated curved faces come out as
+/// many tiny "faces": filter by area.
+std::vector<PlanarFace> planar_faces(const Mesh& mesh, double angle_deg = 1e-4, double distance = 1e-9);
+/// The planar faces of a shape in model units (box: 6, cylinder: its 2
+/// caps, cad-part: those of its mesh larger than 1e-3, sphere/torus: none).
+std::vector<PlanarFace> shape_planar_faces(ShapeKind kind);
+/// A plane under physical = translation + linear * model (linear a similarity).
+PlanarFace transform_face(const PlanarFace& f, const Mat3& linear, const Vec3& translation);
 /// Support function: max over the shape of m . d (d need not be unit).
 double shape_support(ShapeKind kind, const Vec3& d);
 /// Volume of the solid in model units^3 (closed form; one 1-D integral for

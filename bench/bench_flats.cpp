@@ -1,0 +1,202 @@
+// Flats (plane voting) and junctions: detection time and quality, and the
+// Table 2 stages (midpoint, midpoint + tiles, + smoothing) on generated
+// shapes and shared models, randomly rotated.
+//   build/bench/bench_flats                      # the table in docs/BENCHMARKS.md
+//   build/bench/bench_flats --shape box --res 64 --seeds 20
+//   build/bench/bench_flats --model ../shared/data/meshes/fandisk.off --res 128 --seeds 3
+// A true planar face is "found" when a flat's plane is within 1 degree and
+// half a cell of it; a flat matching no true face is "spurious". For models
+// every planar face of the mesh counts (a coarsely tessellated curved face
+// is many small planar faces), so only flat counts and errors are printed.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+
+#include "voxpress/eval/metrics.h"
+#include "voxpress/eval/truth.h"
+#include "voxpress/eval/voxelize.h"
+#include "voxpress/voxpress.h"
+
+using namespace voxpress;
+
+namespace {
+
+struct Case {
+  std::string name;
+  BinaryVolume volume;
+  std::unique_ptr<Truth> truth;
+  std::vector<PlanarFace> faces;  // physical; empty when not judged
+};
+
+double stick_rms(const StickSurface& s, const Truth& truth, const BinaryVolume& v) {
+  EvalOptions eo;
+  eo.volume = &v;
+  eo.samples = 20000;
+  eo.self_intersections = false;
+  return evaluate(to_mesh(s), truth, eo).stick_rms_vox.value_or(NAN);
+}
+
+void run(const Case& c, const FlatOptions& fo, int iterations, bool header) {
+  if (header)
+    std::printf("| case | flats | true faces >= min | found | spurious | worst angle (deg) | estimate s | detect s | "
+                "junctions s | stick: midpoint | + tiles | + smoothing | r->t RMS | normal err (deg) | violations | "
+                "check |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  StickSurface s = extract_sticks(c.volume);
+  const SliceCurves curves = build_slice_curves(s);
+  const double mid = stick_rms(s, *c.truth, c.volume);
+  PressOptions po;
+  po.iterations = iterations;
+  FlatSegmentation seg;
+  const FeaturePressStats st = press_with_flats(s, curves, po, &fo, &seg);
+  StickSurface tiles = s;
+  apply_flats(tiles, seg);
+  const double with_tiles = stick_rms(tiles, *c.truth, c.volume);
+  if (std::getenv("VP_SPLIT")) {
+    // Stick error split by vertex class: frozen, junction, fresh.
+    double sum[3] = {0, 0, 0};
+    size_t cnt[3] = {0, 0, 0};
+    const Lattice& L = c.volume.lattice;
+    for (const StickSurface* x : {&tiles, &s}) {
+      for (int k = 0; k < 3; ++k) sum[k] = 0, cnt[k] = 0;
+      for (size_t v = 0; v < x->stick_count(); ++v) {
+        const auto l = x->lower_index(v);
+        Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
+        Vec3 b = a;
+        b[x->axis(v)] += 1;
+        const double tt = c.truth->crossing(L.to_physical(a), L.to_physical(b), x->t[v]);
+        if (std::isnan(tt)) continue;
+        const int k = seg.region[v] >= 0 ? 0 : seg.junction[v] ? 1 : 2;
+        sum[k] += (tt - x->t[v]) * (tt - x->t[v]);
+        ++cnt[k];
+      }
+      std::fprintf(stderr, "%s: frozen %zu rms %.4f | junction %zu rms %.4f | fresh %zu rms %.4f\n", x == &s ? "final" : "tiles",
+                   cnt[0], std::sqrt(sum[0] / double(cnt[0])), cnt[1], std::sqrt(sum[1] / double(cnt[1])), cnt[2], std::sqrt(sum[2] / double(cnt[2])));
+    }
+  }
+  EvalOptions eo;
+  eo.volume = &c.volume;
+  const EvalReport r = evaluate(to_mesh(s), *c.truth, eo);
+  // Planes against the true faces.
+  const double cell = std::cbrt(c.volume.lattice.spacing.prod());
+  size_t expected = 0, found = 0, spurious = 0;
+  double worst = 0;
+  auto angle = [](const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / std::numbers::pi; };
+  auto matches = [&](const Flat& f, const PlanarFace& t) {
+    return angle(f.normal, t.normal) < 1 && std::abs(f.offset - t.offset) < 0.5 * cell;
+  };
+  if (!c.faces.empty()) {
+    for (const PlanarFace& t : c.faces) {
+      if (t.area / (cell * cell) < fo.min_area) continue;
+      ++expected;
+      bool hit = false;
+      for (const Flat& f : seg.flats) hit |= matches(f, t);
+      found += hit;
+      if (!hit && std::getenv("VP_SPLIT"))
+        std::fprintf(stderr, "missed face: area %.0f cells^2 normal (%.3f %.3f %.3f)\n", t.area / (cell * cell), t.normal.x(), t.normal.y(), t.normal.z());
+    }
+    for (const Flat& f : seg.flats) {
+      bool any = false;
+      double best = 180;
+      for (const PlanarFace& t : c.faces) {
+        any |= matches(f, t);
+        if (std::abs(f.offset - t.offset) < 0.5 * cell) best = std::min(best, angle(f.normal, t.normal));
+      }
+      spurious += !any;
+      worst = std::max(worst, best);
+    }
+  }
+  const auto& fs = st.flats;
+  std::printf("| %s | %zu | %s | %s | %s | %s | %.3f | %.3f | %.3f | %.4f | %.4f | %.4f | %.4f | %.2f | %llu | %s |\n",
+              c.name.c_str(), seg.flats.size(), c.faces.empty() ? "-" : std::to_string(expected).c_str(),
+              c.faces.empty() ? "-" : std::to_string(found).c_str(), c.faces.empty() ? "-" : std::to_string(spurious).c_str(),
+              c.faces.empty() ? "-" : (std::to_string(worst).substr(0, 5)).c_str(), fs.seconds_estimate, fs.seconds_detect,
+              fs.seconds_junctions, mid, with_tiles, r.stick_rms_vox.value_or(NAN), r.result_to_truth_vox.rms,
+              r.normal_error_deg, (unsigned long long)r.classification_violations.value_or(0), r.mesh.ok() ? "ok" : "FAIL");
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"voxpress flats benchmark"};
+  std::string shape, model;
+  int64_t res = 0;
+  int seeds = 0, iterations = 100;
+  FlatOptions fo;
+  app.add_option("--shape", shape, "box | cylinder | cad-part | sphere | torus");
+  app.add_option("--model", model, "a closed mesh to voxelize");
+  app.add_option("--res", res);
+  app.add_option("--seeds", seeds);
+  app.add_option("--iterations", iterations);
+  app.add_option("--min-flat-area", fo.min_area);
+  app.add_option("--flat-bend", fo.max_bend);
+  app.add_option("--flat-tolerance", fo.tolerance);
+  app.add_option("--flat-width", fo.min_width);
+  app.add_option("--flat-spread", fo.max_spread);
+  CLI11_PARSE(app, argc, argv);
+  struct Job {
+    std::string shape, model;
+    int64_t res;
+    int seeds;
+  };
+  std::vector<Job> jobs;
+  if (shape.empty() && model.empty()) {
+    jobs = {{"box", "", 64, 3},       {"box", "", 128, 3},      {"cylinder", "", 64, 2}, {"cylinder", "", 128, 2},
+            {"cad-part", "", 64, 2},  {"cad-part", "", 128, 2}, {"cad-part", "", 256, 1}, {"sphere", "", 128, 1},
+            {"torus", "", 128, 1}};
+    const std::string fandisk = "../shared/data/meshes/fandisk.off";
+    if (std::filesystem::exists(fandisk)) {
+      jobs.push_back({"", fandisk, 128, 3});
+      jobs.push_back({"", fandisk, 256, 2});
+    } else {
+      std::fprintf(stderr, "%s absent: fandisk rows skipped\n", fandisk.c_str());
+    }
+  } else {
+    jobs.push_back({shape, model, res ? res : 128, seeds ? seeds : 1});
+  }
+  bool header = true;
+  for (const Job& j : jobs)
+    for (int seed = 1; seed <= j.seeds; ++seed) {
+      Case c;
+      const std::string rot = "random:" + std::to_string(seed);
+      if (!j.shape.empty()) {
+        GenerateOptions go;
+        go.res = j.res;
+        go.rotation = parse_rotation(rot);
+        GeneratedShape g = generate_shape(parse_shape(j.shape), go);
+        c.truth = shape_truth(g.kind, g.linear, g.translation);
+        for (const PlanarFace& f : shape_planar_faces(g.kind)) c.faces.push_back(transform_face(f, g.linear, g.translation));
+        if (g.kind == ShapeKind::sphere || g.kind == ShapeKind::torus) c.faces.push_back({Vec3(0, 0, 1), 1e300, 0});
+        c.volume = std::move(g.volume);
+        c.name = j.shape + " " + std::to_string(j.res) + " seed " + std::to_string(seed);
+      } else {
+        const Mesh m = read_mesh(j.model);
+        VoxelizeOptions vo;
+        vo.res = j.res;
+        vo.rotation = parse_rotation(rot);
+        Voxelized v = voxelize(m, vo, j.model);
+        Mesh phys = m;
+        for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
+        if (std::getenv("VP_SPLIT")) {
+          double total = 0, planar = 0;
+          for (const PlanarFace& f : planar_faces(phys)) {
+            total += f.area;
+            const double cells = f.area / std::pow(v.placement.lattice.spacing.prod(), 2.0 / 3);
+            if (cells >= fo.min_area) {
+              planar += f.area;
+              std::fprintf(stderr, "  planar face: area %.0f cells^2 normal (%.3f %.3f %.3f)\n", cells, f.normal.x(), f.normal.y(), f.normal.z());
+            }
+          }
+          std::fprintf(stderr, "planar fraction (faces >= min area): %.3f\n", planar / total);
+        }
+        c.truth = mesh_truth(std::move(phys), j.model);
+        c.volume = std::move(v.volume);
+        c.name = std::filesystem::path(j.model).stem().string() + " " + std::to_string(j.res) + " seed " + std::to_string(seed);
+      }
+      run(c, fo, iterations, header);
+      header = false;
+    }
+  return 0;
+}

@@ -1,0 +1,123 @@
+// voxpress/smooth/flats.h — flats by plane voting (max tiles) and junction
+// points (Pressing, Chica et al., Section 3), and the Pressing pipeline that
+// uses them (Section 4, last paragraph, Fig. 7).
+//
+// A flat is a plane together with a connected set of sticks it stabs (a
+// plane stabs a stick when it separates the stick's two samples). Its
+// vertices are frozen where the plane crosses their sticks, strictly inside
+// them, so the in/out guarantee is kept. Detection:
+//
+//  1. Estimate. The surface is pressed once without flats; its vertices and
+//     normals are the local estimate (Pressing's are ~0.5 deg accurate, the
+//     midpoint surface's 20 deg, which would force wide vote cones).
+//  2. Vote. Every vertex whose normal agrees with its neighbours' within
+//     `cone` votes for the plane cells (direction cell, offset bin) near its
+//     normal: directions on an equal-angle cube map (no pile-up at poles),
+//     offsets in bins of one cell. Votes are sorted into an accumulator.
+//  3. Grow, greedily from the best cell (Section 3: "repeat by removing the
+//     sticks of previous planes"): the cell's voters seed a cluster; the
+//     cluster grows over surface edges to every unassigned stick the plane
+//     stabs whose estimated vertex lies within `tolerance` of it; the plane is
+//     refitted (below) and the growth repeated until it stops. A cluster is a
+//     flat if its area is at least `min_area`, its width at least
+//     `min_width`, its normals' median angle to the plane's at most
+//     `max_spread` and their linear trend across it at most `max_bend`
+//     (these reject the strips where a plane is tangent to a curved surface).
+//     The sticks of a flat leave the accumulator; the next best cell follows.
+//  4. Refine. The least-squares plane of the cluster's estimated vertices is
+//     the target; the plane moves from the current one (which stabs the whole
+//     cluster) towards it as far as every cluster stick stays stabbed with
+//     the margin: the constraints are linear in (n, c), so this is an exact
+//     line search. The result is the best-fitting plane on that segment that
+//     is feasible (docs/ARCHITECTURE.md).
+//  5. Rim. The flat finally takes the stabbed sticks within `rim_rings`
+//     surface edges of its core, so it reaches its edges, where the estimate
+//     was rounded.
+//
+// Junctions (Section 3): for an edge joining a frozen vertex of flat F and a
+// fresh vertex V, the normal of the least-squares plane of the fresh vertices
+// in V's 2-ring is compared with F's normal; above `junction_angle` V is a
+// junction (the edge crosses a sharp feature); so is a fresh vertex with
+// fewer than three fresh vertices in its 2-ring (squeezed between flats,
+// whatever the angle). Frozen vertices next to a
+// junction along a slice curve become barriers for the smoothing, which then
+// aligns the vertices within d of them with their smooth side (Fig. 7).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/progress.h"
+#include "voxpress/extract/sticks.h"
+#include "voxpress/smooth/pressing.h"
+
+namespace voxpress {
+
+struct FlatOptions {
+  double min_area = 100;       ///< smallest flat, in cell areas (index space)
+  double junction_angle = 30;  ///< degrees (paper: 30)
+  double cone = 3;             ///< degrees: a vertex votes for directions within this of its normal
+  double tolerance = 0.3;      ///< cells: core vertices lie this close to the plane (estimate)
+  double max_bend = 5;         ///< degrees: largest normal change across a flat's core (linear fit)
+  double max_spread = 1.4;     ///< degrees: largest median angle between a core normal and the plane's
+  double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
+  int rim_rings = 2;           ///< surface rings added around the core
+  double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
+  Progress* progress = nullptr;
+};
+
+struct Flat {
+  Vec3 normal{0, 0, 1};  ///< unit, outward, physical frame: the plane is normal . x = offset
+  double offset = 0;
+  Vec3 index_normal{0, 0, 1};  ///< the same plane in index space (unit in index space)
+  double index_offset = 0;
+  size_t sticks = 0;       ///< sticks frozen on the plane
+  double area = 0;         ///< physical area of the flat's vertices' share of the surface
+  double area_cells = 0;   ///< the same in cell areas (index space)
+};
+
+struct FlatStats {
+  size_t votes = 0, voters = 0, cells = 0, tried = 0;
+  size_t junctions = 0, barriers = 0;
+  double seconds_estimate = 0, seconds_detect = 0, seconds_junctions = 0;
+};
+
+/// The segmentation of a stick surface into flats and the curved rest.
+struct FlatSegmentation {
+  std::vector<Flat> flats;
+  std::vector<int32_t> region;     ///< per stick: flat id, or -1 (curved)
+  std::vector<double> t;           ///< per stick: the frozen t on its flat (NaN when curved)
+  std::vector<uint8_t> junction;   ///< per stick: fresh vertex at a sharp flat border
+  std::vector<uint8_t> barrier;    ///< per stick: frozen vertex where slice curves are cut
+  FlatStats stats;
+  size_t frozen_count() const;
+};
+
+/// Detects flats and junctions. `estimate` holds one t per stick (a pressed
+/// copy of the surface); the surface's own t are not used.
+FlatSegmentation find_flats(const StickSurface& surface, const SliceCurves& curves, const std::vector<double>& estimate,
+                            const FlatOptions& options = {});
+
+/// Sets the frozen vertices of `surface` on their flats and every fresh
+/// vertex to t = 0.5: the "midpoint + tiles" surface of Table 2.
+void apply_flats(StickSurface& surface, const FlatSegmentation& flats);
+
+struct FeaturePressStats {
+  PressStats press;
+  FlatStats flats;
+};
+
+/// The whole Pressing pipeline: estimate (press a copy), find flats and
+/// junctions, freeze, press the fresh vertices with barriers. Without flats
+/// (flat_options == nullptr) it is press() alone. `segmentation` (optional)
+/// receives the flats.
+FeaturePressStats press_with_flats(StickSurface& surface, const SliceCurves& curves, const PressOptions& options,
+                                   const FlatOptions* flat_options, FlatSegmentation* segmentation = nullptr);
+
+/// Per-vertex outputs for the mesh of `surface` (vertex s = stick s):
+/// "region" (int32: flat id, -1 curved) and "junction" (uint8) attributes,
+/// and, when `colors`, a colour per region (curved grey, junctions orange).
+void add_region_attributes(Mesh& mesh, const FlatSegmentation& flats, bool colors);
+
+}  // namespace voxpress

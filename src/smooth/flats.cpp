@@ -1,0 +1,852 @@
+// Flats by plane voting and junction points (Chica et al., Section 3), and
+// the Pressing pipeline around them. Theory of operation:
+// include/voxpress/smooth/flats.h. Everything here works in index space
+// (planes are affine-invariant); normals and angles that are compared with
+// user thresholds are taken in the physical frame.
+#include "voxpress/smooth/flats.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <queue>
+
+namespace voxpress {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kCube = 64;  // cube-map cells per face side: ~1.4 degrees
+constexpr int kNormalRings = 3;  // smoothing rounds of the estimated normals
+constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// ---------------------------------------------------------------- directions
+// Equal-angle cube map: face (axis a, sign), the two other coordinates
+// divided by |d_a| and mapped through atan, so cells span equal angles along
+// each face axis (solid angles within a factor 1.4 of each other; a plain
+// cube map has 5.2, a latitude-longitude grid is unbounded at the poles).
+uint32_t direction_cell(const Vec3& d) {
+  int a = 0;
+  if (std::abs(d.y()) > std::abs(d[a])) a = 1;
+  if (std::abs(d.z()) > std::abs(d[a])) a = 2;
+  const double m = std::abs(d[a]);
+  const int face = 2 * a + (d[a] < 0);
+  auto cell = [m](double x) {
+    const double s = std::atan(x / m) * (4 / kPi);  // [-1, 1]
+    return std::clamp(int(std::floor((s + 1) * 0.5 * kCube)), 0, kCube - 1);
+  };
+  return uint32_t((face * kCube + cell(d[(a + 2) % 3])) * kCube + cell(d[(a + 1) % 3]));
+}
+
+Vec3 cell_direction(uint32_t c) {
+  const int i = int(c % kCube), j = int(c / kCube % kCube), face = int(c / (kCube * kCube));
+  const int a = face / 2;
+  const double sign = face % 2 ? -1 : 1;
+  auto coord = [](int k) { return std::tan(((k + 0.5) * 2.0 / kCube - 1) * kPi / 4); };
+  Vec3 d;
+  d[a] = sign;
+  d[(a + 1) % 3] = coord(i);
+  d[(a + 2) % 3] = coord(j);
+  return d.normalized();
+}
+
+// Unit vectors spanning the plane orthogonal to unit n.
+void frame(const Vec3& n, Vec3& u, Vec3& v) {
+  const Vec3 h = std::abs(n.x()) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+  u = n.cross(h).normalized();
+  v = n.cross(u);
+}
+
+// A vertex's votes: the distinct cells of its normal and of six directions
+// 0.7 cone away around it, each with the bin of the vertex's offset.
+constexpr int kMaxVotes = 7;
+int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out) {
+  Vec3 u, v;
+  frame(n, u, v);
+  const double r = std::tan(0.7 * cone);
+  int count = 0;
+  for (int k = 0; k < kMaxVotes; ++k) {
+    const double ang = k * kPi / 3;
+    const Vec3 d = k == 0 ? n : Vec3((n + r * (std::cos(ang) * u + std::sin(ang) * v)).normalized());
+    const uint32_t c = direction_cell(d);
+    const double off = cell_direction(c).dot(x);
+    const uint64_t key = (uint64_t(c) << 32) | uint32_t(int64_t(std::floor(off)) + (int64_t(1) << 30));
+    bool dup = false;
+    for (int q = 0; q < count; ++q) dup |= out[q] == key;
+    if (!dup) out[count++] = key;
+  }
+  return count;
+}
+
+// ---------------------------------------------------------------- planes
+// Oriented plane n . x = c (index space), inside at n . x < c.
+struct Plane {
+  Vec3 n{0, 0, 1};
+  double c = 0;
+};
+
+// Principal axes of points: mean, eigenvalues ascending, the smallest's axis.
+struct Pca {
+  Vec3 mean, eigenvalues, normal;
+};
+Pca pca(const std::vector<Vec3>& pts) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : pts) mean += p;
+  mean /= double(pts.size());
+  Mat3 cov = Mat3::Zero();
+  for (const Vec3& p : pts) cov += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  return {mean, es.eigenvalues(), es.eigenvectors().col(0)};
+}
+
+// Least-squares plane (orthogonal PCA) of points, oriented along `towards`.
+Plane fit_plane(const std::vector<Vec3>& pts, const Vec3& towards) {
+  const Pca q = pca(pts);
+  const Vec3 n = q.normal.dot(towards) < 0 ? Vec3(-q.normal) : q.normal;
+  return {n, n.dot(q.mean)};
+}
+
+// The surface data the detector reads.
+struct Surface {
+  const StickSurface* s;
+  std::vector<Vec3> x, nrm;         // estimated vertex positions and unit normals (index space)
+  std::vector<double> area;         // a third of the incident triangle areas (index space)
+  std::vector<uint32_t> adj_off, adj;  // vertex adjacency (CSR)
+  // Samples of stick v: inside and outside endpoints.
+  Vec3 inside(size_t v) const {
+    const auto l = s->lower_index(v);
+    Vec3 p = Vec3(double(l[0]), double(l[1]), double(l[2]));
+    if (!s->lower_inside(v)) p[s->axis(v)] += 1;
+    return p;
+  }
+  Vec3 outside(size_t v) const {
+    const auto l = s->lower_index(v);
+    Vec3 p = Vec3(double(l[0]), double(l[1]), double(l[2]));
+    if (s->lower_inside(v)) p[s->axis(v)] += 1;
+    return p;
+  }
+};
+
+// t (from the inside sample) where the plane crosses stick v, or NaN when it
+// does not cross it with the margin.
+double crossing(const Surface& S, size_t v, const Plane& P, double margin) {
+  const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
+  if (!(fi < 0 && fo > 0)) return std::numeric_limits<double>::quiet_NaN();
+  const double t = -fi / (fo - fi);
+  return t >= margin && t <= 1 - margin ? t : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The largest lambda in [0, 1] such that (1 - lambda) P0 + lambda P1 stabs
+// every stick of `cluster` with the margin (P0 does). The constraints
+// -f(in) - m (f(out) - f(in)) >= 0 and f(out) - m (f(out) - f(in)) >= 0 are
+// linear in (n, c), so each bounds lambda in closed form.
+double feasible_step(const Surface& S, const std::vector<uint32_t>& cluster, const Plane& P0, const Plane& P1,
+                     double m) {
+  double lambda = 1;
+  auto g = [&](const Plane& P, uint32_t v, double& g1, double& g2) {
+    const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
+    g1 = -fi - m * (fo - fi);
+    g2 = fo - m * (fo - fi);
+  };
+  for (uint32_t v : cluster) {
+    double a1, a2, b1, b2;
+    g(P0, v, a1, a2);
+    g(P1, v, b1, b2);
+    if (b1 < 0) lambda = std::min(lambda, std::max(0.0, a1) / (std::max(0.0, a1) - b1));
+    if (b2 < 0) lambda = std::min(lambda, std::max(0.0, a2) / (std::max(0.0, a2) - b2));
+  }
+  return lambda * (1 - 1e-9);
+}
+
+// Minimum-norm point of {w : a_i . w >= b_i} in R^3, by Seidel's randomized
+// incremental method (an LP-type problem of combinatorial dimension 3): if
+// constraint i cuts off the optimum of the earlier ones, the new optimum lies
+// on its boundary, so recurse on it with one more equality. Expected O(m).
+class MinNorm {
+ public:
+  MinNorm(const std::vector<Eigen::Vector3d>& a, const std::vector<double>& b) : a_(a), b_(b), order_(a.size()) {
+    // A fixed pseudo-random order: deterministic results.
+    std::vector<std::pair<uint64_t, uint32_t>> key(a.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      uint64_t z = i + 0x9E3779B97F4A7C15ull;
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+      key[i] = {z ^ (z >> 31), uint32_t(i)};
+    }
+    std::sort(key.begin(), key.end());
+    for (size_t i = 0; i < a.size(); ++i) order_[i] = key[i].second;
+  }
+  bool solve(Eigen::Vector3d& w) {
+    int E[3];
+    return solve(order_.size(), E, 0, w);
+  }
+
+ private:
+  // The point of {a_e . w = b_e, e in E} nearest the origin.
+  bool project(const int* E, int k, Eigen::Vector3d& w) const {
+    if (k == 0) {
+      w.setZero();
+      return true;
+    }
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (int q = 0; q < k; ++q) {
+      A.col(q) = a_[size_t(E[q])];
+      rhs(q) = b_[size_t(E[q])];
+    }
+    const Eigen::MatrixXd Ak = A.leftCols(k);
+    const Eigen::MatrixXd G = Ak.transpose() * Ak;
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(G);
+    lu.setThreshold(1e-12);
+    if (lu.rank() < k) return false;
+    w = Ak * lu.solve(rhs.head(k));
+    return true;
+  }
+  bool solve(size_t count, int* E, int k, Eigen::Vector3d& w) {
+    if (!project(E, k, w)) return false;
+    for (size_t q = 0; q < count; ++q) {
+      const uint32_t i = order_[q];
+      if (a_[i].dot(w) >= b_[i] - 1e-12 * (1 + std::abs(b_[i]))) continue;
+      if (k == 3) return false;  // only rounding can get here
+      E[k] = int(i);
+      if (!solve(q, E, k + 1, w)) return false;
+    }
+    return true;
+  }
+  const std::vector<Eigen::Vector3d>& a_;
+  const std::vector<double>& b_;
+  std::vector<uint32_t> order_;
+};
+
+// Section 3's plane refinement, our choice of "best": least squares inside
+// the feasible set. With n = n_F + a u + b v (n_F the least-squares normal
+// of the points, u, v orthonormal to it) and the plane n . (x - m) = c'
+// through the points' mean m, the squared residuals are a quadratic in
+// z = (a, b, c') minimised at z = 0, and "the plane stabs stick s with the
+// margin" is two linear inequalities in z. With H = L L^T the residuals'
+// Hessian and w = L^T z this is the minimum-norm point of a polytope.
+// Returns false when the cluster is infeasible or the solver fails
+// numerically (the caller keeps a feasible plane).
+bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, const std::vector<Vec3>& pts,
+                     const Vec3& towards, double margin, Plane& out) {
+  Vec3 m = Vec3::Zero();
+  for (const Vec3& p : pts) m += p;
+  m /= double(pts.size());
+  const Plane F = fit_plane(pts, towards);
+  Vec3 u, v;
+  frame(F.n, u, v);
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  for (const Vec3& p : pts) {
+    const Eigen::Vector3d z(u.dot(p - m), v.dot(p - m), -1);
+    H += z * z.transpose();
+  }
+  H += 1e-12 * H.trace() * Eigen::Matrix3d::Identity();
+  const Eigen::LLT<Eigen::Matrix3d> llt(H);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::Matrix3d L = llt.matrixL();
+  std::vector<Eigen::Vector3d> A;
+  std::vector<double> B;
+  A.reserve(2 * cluster.size());
+  B.reserve(2 * cluster.size());
+  for (uint32_t s : cluster) {
+    // f(p) = n_F . (p - m) + phi(p) . z with phi(p) = (u . (p - m), v . (p - m), -1).
+    const Vec3 pi = S.inside(s) - m, po = S.outside(s) - m;
+    const Eigen::Vector3d phi_i(u.dot(pi), v.dot(pi), -1), phi_o(u.dot(po), v.dot(po), -1);
+    const double fi = F.n.dot(pi), fo = F.n.dot(po);
+    // g1 = -(1 - m) f(in) - m f(out) >= 0,  g2 = (1 - m) f(out) + m f(in) >= 0.
+    const Eigen::Vector3d g1 = -(1 - margin) * phi_i - margin * phi_o, g2 = (1 - margin) * phi_o + margin * phi_i;
+    const double k1 = -(1 - margin) * fi - margin * fo, k2 = (1 - margin) * fo + margin * fi;
+    // g . z = g . L^-T w = (L^-1 g) . w
+    A.push_back(L.triangularView<Eigen::Lower>().solve(g1));
+    B.push_back(-k1);
+    A.push_back(L.triangularView<Eigen::Lower>().solve(g2));
+    B.push_back(-k2);
+  }
+  MinNorm qp(A, B);
+  Eigen::Vector3d w;
+  if (!qp.solve(w)) return false;
+  const Eigen::Vector3d z = L.transpose().triangularView<Eigen::Upper>().solve(w);
+  Plane P{F.n + z(0) * u + z(1) * v, 0};
+  P.c = z(2) + P.n.dot(m);
+  const double len = P.n.norm();
+  P.n /= len;
+  P.c /= len;
+  for (uint32_t s : cluster)
+    if (std::isnan(crossing(S, s, P, margin))) return false;
+  out = P;
+  return true;
+}
+
+Plane lerp(const Plane& a, const Plane& b, double l) {
+  Plane p{(1 - l) * a.n + l * b.n, (1 - l) * a.c + l * b.c};
+  const double len = p.n.norm();
+  p.n /= len;
+  p.c /= len;
+  return p;
+}
+
+// ---------------------------------------------------------------- detection
+struct Detector {
+  const Surface& S;
+  const FlatOptions& o;
+  std::vector<int32_t>& region;  // -1 unassigned
+  std::vector<uint32_t> mark;    // per vertex: stamp of the cluster being grown
+  uint32_t stamp = 0;
+
+  double cos_cone;
+  // A core vertex: its stick stabbed, its estimated vertex within tol of the
+  // plane and its estimated normal within the cone of the plane's.
+  bool near(uint32_t v, const Plane& P, double tol) const {
+    return S.nrm[v].dot(P.n) >= cos_cone && std::abs(P.n.dot(S.x[v]) - P.c) <= tol &&
+           !std::isnan(crossing(S, v, P, o.margin));
+  }
+
+  // Breadth-first growth of `cluster` (all marked with the current stamp)
+  // over unassigned neighbours accepted by `ok`, at most `rings` rings (-1: no limit).
+  template <class Ok>
+  void grow(std::vector<uint32_t>& cluster, size_t from, int rings, Ok ok) {
+    size_t begin = from, end = cluster.size();
+    for (int r = 0; rings < 0 || r < rings; ++r) {
+      for (size_t q = begin; q < end; ++q) {
+        const uint32_t v = cluster[q];
+        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) {
+          const uint32_t w = S.adj[k];
+          if (mark[w] == stamp || region[w] >= 0 || !ok(w)) continue;
+          mark[w] = stamp;
+          cluster.push_back(w);
+        }
+      }
+      if (cluster.size() == end) break;
+      begin = end;
+      end = cluster.size();
+    }
+  }
+
+  // A cluster from the voters of one accumulator cell; empty if rejected.
+  // `rejected` receives the core of a rejected cluster.
+  std::vector<uint32_t> cluster_from(const std::vector<uint32_t>& seeds, Plane& P, std::vector<uint32_t>& rejected) {
+    std::vector<Vec3> pts;
+    Vec3 mean_n = Vec3::Zero();
+    for (uint32_t v : seeds) {
+      pts.push_back(S.x[v]);
+      mean_n += S.nrm[v];
+    }
+    P = fit_plane(pts, mean_n);
+    // The largest connected set of seeds the plane holds.
+    std::vector<uint32_t> best;
+    const uint32_t seed_mark = ++stamp, visited = ++stamp;
+    for (uint32_t v : seeds)
+      if (near(v, P, o.tolerance)) mark[v] = seed_mark;
+    for (uint32_t v : seeds) {
+      if (mark[v] != seed_mark) continue;
+      std::vector<uint32_t> comp{v};
+      mark[v] = visited;
+      for (size_t q = 0; q < comp.size(); ++q)
+        for (uint32_t k = S.adj_off[comp[q]]; k < S.adj_off[comp[q] + 1]; ++k) {
+          const uint32_t w = S.adj[k];
+          if (mark[w] == seed_mark) {
+            mark[w] = visited;
+            comp.push_back(w);
+          }
+        }
+      if (comp.size() > best.size()) best.swap(comp);
+    }
+    if (best.size() < 3) return {};
+    ++stamp;
+    for (uint32_t v : best) mark[v] = stamp;
+    std::vector<uint32_t> core = std::move(best);
+    for (int round = 0; round < 12; ++round) {
+      const size_t before = core.size();
+      grow(core, 0, -1, [&](uint32_t w) { return near(w, P, o.tolerance); });
+      pts.resize(core.size());
+      for (size_t q = 0; q < core.size(); ++q) pts[q] = S.x[core[q]];
+      Plane next;
+      if (!constrained_fit(S, core, pts, P.n, o.margin, next)) {
+        // Fallback: from the current (feasible) plane towards the
+        // least-squares one as far as feasibility allows.
+        const Plane F = fit_plane(pts, P.n);
+        next = lerp(P, F, feasible_step(S, core, P, F, o.margin));
+      }
+      const double moved = (next.n - P.n).norm() + std::abs(next.c - P.c);
+      P = next;
+      if (core.size() == before && moved < 1e-7) break;
+    }
+    if (!accept(core, P)) {
+      rejected = std::move(core);
+      return {};
+    }
+    grow(core, 0, o.rim_rings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
+    return core;
+  }
+
+  // Section 3's minimum size, plus width and bend (beyond the paper: without
+  // them a plane tangent to a cylinder holds a long strip of its sticks).
+  bool accept(const std::vector<uint32_t>& core, const Plane& P) const {
+    double area = 0;
+    for (uint32_t v : core) area += S.area[v];
+    if (area < o.min_area) return false;
+    // Spread of the normals about the plane's, robust to the rounded rims:
+    // the median angle. A strip where a plane is tangent to a curved surface
+    // is *defined* by the cone, so its normals fill it (median ~ cone / 2 at
+    // any resolution, whether the strip is straight or a torus's ring); a
+    // face's sit near the plane's normal. (Measured: strips 1.4-2.5 deg,
+    // faces 0.2-1.25 deg with the default 3 deg cone.)
+    std::vector<double> spread(core.size());
+    for (size_t q = 0; q < core.size(); ++q) spread[q] = std::acos(std::clamp(S.nrm[core[q]].dot(P.n), -1.0, 1.0));
+    std::nth_element(spread.begin(), spread.begin() + ptrdiff_t(spread.size() / 2), spread.end());
+    // At 64^3 the estimate of a box is a pillow and its smaller faces spread
+    // up to 1.8 deg: they are missed (docs/BENCHMARKS.md).
+    if (spread[spread.size() / 2] > o.max_spread * kPi / 180) return false;
+    Vec3 u, v;
+    frame(P.n, u, v);
+    // In-plane coordinates, centred.
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (uint32_t q : core) mean += Eigen::Vector2d(S.x[q].dot(u), S.x[q].dot(v));
+    mean /= double(core.size());
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    // Normal bend: tangential normal components regressed on position,
+    // (nu, nv) = A + B (pu, pv); B's largest singular value is a curvature.
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
+    for (uint32_t q : core) {
+      const Eigen::Vector2d p = Eigen::Vector2d(S.x[q].dot(u), S.x[q].dot(v)) - mean;
+      cov += p * p.transpose();
+      const Eigen::Vector3d a(1, p.x(), p.y());
+      ata += a * a.transpose();
+      atb += a * Eigen::RowVector2d(S.nrm[q].dot(u), S.nrm[q].dot(v));
+    }
+    cov /= double(core.size());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> pe(cov);
+    if (std::sqrt(12 * std::max(0.0, pe.eigenvalues()(0))) < o.min_width) return false;
+    const Eigen::Matrix<double, 3, 2> coef = ata.ldlt().solve(atb);
+    Eigen::Matrix2d B = coef.bottomRows<2>().transpose();  // rows: nu, nv; columns: d/dpu, d/dpv
+    const Eigen::Matrix2d sym = 0.5 * (B + B.transpose());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> be(sym);
+    const int big = std::abs(be.eigenvalues()(0)) > std::abs(be.eigenvalues()(1)) ? 0 : 1;
+    const double kappa = std::abs(be.eigenvalues()(big));
+    const Eigen::Vector2d dir = be.eigenvectors().col(big);
+    double lo = 1e300, hi = -1e300;
+    for (uint32_t q : core) {
+      const double s = Eigen::Vector2d(S.x[q].dot(u), S.x[q].dot(v)).dot(dir);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    return kappa * (hi - lo) <= o.max_bend * kPi / 180;
+  }
+};
+
+Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
+  Surface S;
+  S.s = &s;
+  const size_t n = s.stick_count();
+  S.x.resize(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    const auto l = s.lower_index(v);
+    Vec3 p = Vec3(double(l[0]), double(l[1]), double(l[2]));
+    p[s.axis(v)] += t[v];
+    S.x[v] = p;
+  });
+  S.nrm.assign(n, Vec3::Zero());
+  S.area.assign(n, 0);
+  std::vector<uint32_t> deg(n + 1, 0);
+  for (const Triangle& tr : s.triangles) {
+    const Vec3 c = (S.x[tr[1]] - S.x[tr[0]]).cross(S.x[tr[2]] - S.x[tr[0]]);
+    for (uint32_t v : tr) {
+      S.nrm[v] += c;
+      S.area[v] += c.norm() / 6;
+      deg[v] += 2;
+    }
+  }
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    const double l = S.nrm[v].norm();
+    S.nrm[v] = l > 0 ? Vec3(S.nrm[v] / l) : Vec3(0, 0, 1);
+  });
+  // Adjacency: every triangle edge, once per direction; duplicates removed.
+  S.adj_off.assign(n + 1, 0);
+  for (size_t v = 0; v < n; ++v) S.adj_off[v + 1] = S.adj_off[v] + deg[v];
+  S.adj.resize(S.adj_off[n]);
+  std::vector<uint32_t> fill(S.adj_off.begin(), S.adj_off.end() - 1);
+  for (const Triangle& tr : s.triangles)
+    for (int e = 0; e < 3; ++e) {
+      S.adj[fill[tr[size_t(e)]]++] = tr[size_t((e + 1) % 3)];
+      S.adj[fill[tr[size_t(e)]]++] = tr[size_t((e + 2) % 3)];
+    }
+  // Deduplicate each list in place, then compact.
+  uint32_t out = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const uint32_t b = S.adj_off[v], e = S.adj_off[v + 1];
+    std::sort(S.adj.begin() + b, S.adj.begin() + e);
+    const uint32_t start = out;
+    for (uint32_t k = b; k < e; ++k)
+      if (k == b || S.adj[k] != S.adj[k - 1]) S.adj[out++] = S.adj[k];
+    S.adj_off[v] = start;
+  }
+  S.adj_off[n] = out;
+  S.adj.resize(out);
+  // Per-vertex normals of the pressed surface still carry a few degrees of
+  // staircase noise; averaging over a few rings brings them under one.
+  std::vector<Vec3> next(n);
+  for (int round = 0; round < kNormalRings; ++round) {
+    tbb::parallel_for(size_t(0), n, [&](size_t v) {
+      Vec3 sum = S.nrm[v];
+      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) sum += S.nrm[S.adj[k]];
+      const double l = sum.norm();
+      next[v] = l > 0 ? Vec3(sum / l) : S.nrm[v];
+    });
+    S.nrm.swap(next);
+  }
+  return S;
+}
+
+Vec3 to_physical_normal(const Mat3& Minv_t, const Vec3& n) { return (Minv_t * n).normalized(); }
+
+}  // namespace
+
+size_t FlatSegmentation::frozen_count() const {
+  size_t c = 0;
+  for (int32_t r : region) c += r >= 0;
+  return c;
+}
+
+FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, const std::vector<double>& estimate,
+                            const FlatOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t n = s.stick_count();
+  if (estimate.size() != n) throw std::invalid_argument("find_flats: the estimate does not match the sticks");
+  FlatSegmentation seg;
+  seg.region.assign(n, -1);
+  seg.t.assign(n, std::numeric_limits<double>::quiet_NaN());
+  seg.junction.assign(n, 0);
+  seg.barrier.assign(n, 0);
+  if (n == 0) return seg;
+  const Surface S = make_surface(s, estimate);
+  const double cone = o.cone * kPi / 180, cos_cone = std::cos(cone);
+
+  // ---- Votes (Section 3): only vertices whose normal agrees with every
+  // neighbour's within the cone (curved regions then vote little).
+  std::vector<uint64_t> keys(n * kMaxVotes);
+  std::vector<uint8_t> count(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v < r.end(); ++v) {
+      bool planar = true;
+      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && planar; ++k)
+        planar = S.nrm[v].dot(S.nrm[S.adj[k]]) >= cos_cone;
+      if (planar) count[v] = uint8_t(votes_of(S.nrm[v], S.x[v], cone, &keys[v * kMaxVotes]));
+    }
+  });
+  std::vector<uint64_t> offsets(n + 1, 0);
+  for (size_t v = 0; v < n; ++v) offsets[v + 1] = offsets[v] + count[v];
+  seg.stats.votes = offsets[n];
+  // (key, voter) pairs sorted: runs are accumulator cells with their voters.
+  struct Vote {
+    uint64_t key;
+    uint32_t voter;
+    bool operator<(const Vote& b) const { return key < b.key || (key == b.key && voter < b.voter); }
+  };
+  std::vector<Vote> votes(offsets[n]);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    for (uint32_t q = 0; q < count[v]; ++q) votes[offsets[v] + q] = {keys[v * kMaxVotes + q], uint32_t(v)};
+  });
+  for (size_t v = 0; v < n; ++v) seg.stats.voters += count[v] > 0;
+  tbb::parallel_sort(votes.begin(), votes.end());
+  std::vector<uint64_t> cell_key;
+  std::vector<uint32_t> cell_begin, cell_count;
+  for (size_t i = 0; i < votes.size(); ++i)
+    if (i == 0 || votes[i].key != votes[i - 1].key) {
+      cell_key.push_back(votes[i].key);
+      cell_begin.push_back(uint32_t(i));
+      cell_count.push_back(0);
+      ++cell_count.back();
+    } else {
+      ++cell_count.back();
+    }
+  cell_begin.push_back(uint32_t(votes.size()));
+  seg.stats.cells = cell_key.size();
+  auto cell_of = [&](uint64_t key) {
+    return size_t(std::lower_bound(cell_key.begin(), cell_key.end(), key) - cell_key.begin());
+  };
+
+  // ---- Greedy extraction, best cell first (lazy max-heap; ties by cell index).
+  std::priority_queue<std::pair<uint32_t, int64_t>> heap;
+  for (size_t c = 0; c < cell_key.size(); ++c) heap.push({cell_count[c], -int64_t(c)});
+  Detector det{S, o, seg.region, std::vector<uint32_t>(n, 0), 0, cos_cone};
+  ProgressCounter progress(o.progress, "flats", 0);
+  const Mat3 M = s.lattice.index_to_physical_matrix();
+  const Mat3 Minv_t = M.inverse().transpose();
+  std::vector<uint32_t> seeds;
+  std::vector<uint8_t> voting(count.begin(), count.end());
+  auto unvote = [&](uint32_t v) {  // drops the stick's votes from the accumulator
+    if (!voting[v]) return;
+    voting[v] = 0;
+    uint64_t mine[kMaxVotes];
+    const int k = votes_of(S.nrm[v], S.x[v], cone, mine);
+    for (int q = 0; q < k; ++q) {
+      const size_t cc = cell_of(mine[q]);
+      if (cc < cell_key.size() && cell_key[cc] == mine[q] && cell_count[cc] > 0) --cell_count[cc];
+    }
+  };
+  while (!heap.empty()) {
+    const auto [cnt, neg] = heap.top();
+    heap.pop();
+    const size_t c = size_t(-neg);
+    if (cnt != cell_count[c]) {
+      if (cell_count[c] > 0) heap.push({cell_count[c], neg});
+      continue;
+    }
+    // A flat covers at most one cell area per stick, so fewer voters than
+    // min_area cannot make one: nothing left can.
+    if (double(cnt) < o.min_area) break;
+    ++seg.stats.tried;
+    seeds.clear();
+    for (uint32_t i = cell_begin[c]; i < cell_begin[c + 1]; ++i)
+      if (seg.region[votes[i].voter] < 0) seeds.push_back(votes[i].voter);
+    cell_count[c] = 0;  // used: accepted or not, this cell is done
+    if (double(seeds.size()) < o.min_area) continue;
+    Plane P;
+    std::vector<uint32_t> rejected;
+    const std::vector<uint32_t> members = det.cluster_from(seeds, P, rejected);
+    // A rejected core's vertices stop voting (they may still join a flat
+    // grown from elsewhere): without this a cylinder's wall is tried once per
+    // direction cell along its circle of normals.
+    for (uint32_t v : rejected) unvote(v);
+    if (members.empty()) continue;
+    const int32_t id = int32_t(seg.flats.size());
+    Flat f;
+    f.index_normal = P.n;
+    f.index_offset = P.c;
+    f.normal = to_physical_normal(Minv_t, P.n);
+    // Physical plane: n_i . M^-1 (x - origin) = c.
+    const Vec3 np = Minv_t * P.n;
+    f.offset = (P.c + np.dot(s.lattice.origin)) / np.norm();
+    f.sticks = members.size();
+    const double det_m = std::abs(M.determinant());
+    for (uint32_t v : members) {
+      seg.region[v] = id;
+      // Members were stabbed with the margin; only rounding could put t a
+      // hair outside it, so clamp (the sign test cannot fail: see crossing).
+      const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
+      if (!(fi < 0 && fo > 0)) throw std::logic_error("find_flats: a flat's plane does not cross one of its sticks");
+      seg.t[v] = std::clamp(-fi / (fo - fi), o.margin, 1 - o.margin);
+      // Index-space area -> physical: scaled by |det M| |M^-T n| for a plane of normal n.
+      f.area_cells += S.area[v];
+      unvote(v);
+    }
+    f.area = f.area_cells * det_m * np.norm();
+    seg.flats.push_back(f);
+    progress.add(1);
+  }
+  seg.stats.seconds_detect = seconds_since(t0);
+
+  // ---- Junctions (Section 3): fresh vertices next to a frozen one whose
+  // fresh 2-ring plane leans more than junction_angle from the flat.
+  const auto t1 = std::chrono::steady_clock::now();
+  const double cos_j = std::cos(o.junction_angle * kPi / 180);
+  auto detect_junctions = [&] {
+  std::fill(seg.junction.begin(), seg.junction.end(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+      std::vector<uint32_t> ring;
+      std::vector<Vec3> pts;
+      for (size_t v = r.begin(); v < r.end(); ++v) {
+        if (seg.region[v] >= 0) continue;
+        bool near_flat = false;
+        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) near_flat |= seg.region[S.adj[k]] >= 0;
+        if (!near_flat) continue;
+        // Fresh vertices of the 2-ring (v included), in physical space.
+        ring.assign(1, uint32_t(v));
+        for (int depth = 0; depth < 2; ++depth) {
+          const size_t end = ring.size();
+          for (size_t q = 0; q < end; ++q)
+            for (uint32_t k = S.adj_off[ring[q]]; k < S.adj_off[ring[q] + 1]; ++k) {
+              const uint32_t w = S.adj[k];
+              if (seg.region[w] < 0 && std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
+            }
+        }
+        bool sharp = true;  // too few fresh vertices for a plane: squeezed between flats
+        if (ring.size() >= 3) {
+          pts.clear();
+          for (uint32_t w : ring) pts.push_back(M * S.x[w]);
+          const Pca q = pca(pts);
+          if (q.eigenvalues(1) > 1e-9 * std::max(1.0, q.eigenvalues(2))) {  // not collinear
+            const Vec3 ns = q.normal;
+            sharp = false;
+            for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) {
+              const int32_t f = seg.region[S.adj[k]];
+              if (f >= 0 && std::abs(ns.dot(seg.flats[size_t(f)].normal)) < cos_j) sharp = true;
+            }
+          }
+        }
+        seg.junction[v] = sharp;
+      }
+    });
+  };
+  std::vector<Plane> planes(seg.flats.size());
+  std::vector<Vec3> centroid(seg.flats.size(), Vec3::Zero());
+  {
+    std::vector<size_t> members(seg.flats.size(), 0);
+    for (size_t v = 0; v < n; ++v)
+      if (seg.region[v] >= 0) {
+        centroid[size_t(seg.region[v])] += S.x[v];
+        ++members[size_t(seg.region[v])];
+      }
+    for (size_t f = 0; f < planes.size(); ++f) {
+      planes[f] = {seg.flats[f].index_normal, seg.flats[f].index_offset};
+      centroid[f] /= double(std::max<size_t>(members[f], 1));
+    }
+  }
+  // Beyond the paper: flats reach their sharp edges. At a convex edge the
+  // solid is the intersection of the two half-spaces, so every stick there
+  // is stabbed by at least one of the planes and its true crossing is the
+  // one nearest its inside sample; at a concave edge (union) the farthest.
+  // A fresh vertex flagged as a junction joins a neighbouring flat whose
+  // plane stabs its stick, and a frozen vertex moves to a neighbouring flat
+  // when that rule prefers it; a few rounds, junctions recomputed each time.
+  // Smooth borders (no junction) are left to the smoothing.
+  auto prefer = [&](int32_t f, double tf, int32_t g, double tg) {
+    // true when (g, tg) is the better crossing than (f, tf) for this stick
+    const bool convex = planes[size_t(g)].n.dot(centroid[size_t(f)]) < planes[size_t(g)].c;
+    return convex ? tg < tf : tg > tf;
+  };
+  for (int round = 0; round < kExtendRounds && !seg.flats.empty(); ++round) {
+    detect_junctions();
+    std::vector<std::pair<uint32_t, int32_t>> moves;
+    for (size_t v = 0; v < n; ++v) {
+      const int32_t cur = seg.region[v];
+      if (cur < 0 && !seg.junction[v]) continue;
+      int32_t best = cur;
+      double tb = cur >= 0 ? crossing(S, v, planes[size_t(cur)], 0) : 0;
+      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) {
+        const int32_t g = seg.region[S.adj[k]];
+        if (g < 0 || g == best) continue;
+        const double tg = crossing(S, v, planes[size_t(g)], o.margin);
+        if (std::isnan(tg)) continue;
+        if (best < 0 || prefer(best, tb, g, tg)) {
+          best = g;
+          tb = tg;
+        }
+      }
+      if (best != cur) moves.push_back({uint32_t(v), best});
+    }
+    if (moves.empty()) break;
+    for (const auto& [v, f] : moves) {
+      if (seg.region[v] >= 0) --seg.flats[size_t(seg.region[v])].sticks;
+      seg.region[v] = f;
+      seg.t[v] = crossing(S, v, planes[size_t(f)], o.margin);
+      ++seg.flats[size_t(f)].sticks;
+    }
+  }
+  detect_junctions();
+  // Final sizes (the extension moved sticks between flats).
+  for (Flat& f : seg.flats) f.sticks = 0, f.area_cells = 0;
+  for (size_t v = 0; v < n; ++v)
+    if (seg.region[v] >= 0) {
+      Flat& f = seg.flats[size_t(seg.region[v])];
+      ++f.sticks;
+      f.area_cells += S.area[v];
+    }
+  for (Flat& f : seg.flats) f.area = f.area_cells * std::abs(M.determinant()) * (Minv_t * f.index_normal).norm();
+  // Barriers: frozen vertices next to a junction along a slice curve.
+  for (int a = 0; a < 3; ++a) {
+    const auto& ids = curves.ids[a];
+    const auto& off = curves.offsets[a];
+    for (size_t cv = 0; cv + 1 < off.size(); ++cv) {
+      const uint32_t b = off[cv], m = off[cv + 1] - b;
+      for (uint32_t i = 0; i < m; ++i) {
+        const uint32_t p = ids[b + i], q = ids[b + (i + 1) % m];
+        if (seg.region[p] >= 0 && seg.junction[q]) seg.barrier[p] = 1;
+        if (seg.region[q] >= 0 && seg.junction[p]) seg.barrier[q] = 1;
+      }
+    }
+  }
+  for (size_t v = 0; v < n; ++v) {
+    seg.stats.junctions += seg.junction[v];
+    seg.stats.barriers += seg.barrier[v];
+  }
+  seg.stats.seconds_junctions = seconds_since(t1);
+  return seg;
+}
+
+void apply_flats(StickSurface& s, const FlatSegmentation& f) {
+  for (size_t v = 0; v < s.stick_count(); ++v) {
+    if (f.region[v] < 0) {
+      s.t[v] = 0.5;
+      continue;
+    }
+    // seg.t is measured from the inside sample; StickSurface::t from the lower one.
+    s.t[v] = s.lower_inside(v) ? f.t[v] : 1 - f.t[v];
+  }
+}
+
+FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
+                                   const FlatOptions* fo, FlatSegmentation* out) {
+  FeaturePressStats st;
+  if (!fo) {
+    st.press = press(s, curves, po);
+    if (out) {
+      *out = FlatSegmentation{};
+      out->region.assign(s.stick_count(), -1);
+    }
+    return st;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  StickSurface est = s;
+  PressOptions eo = po;
+  eo.iterations = std::max(po.iterations, 60);  // the estimate needs a converged surface
+  press(est, curves, eo);
+  const double t_est = seconds_since(t0);
+  FlatSegmentation seg = find_flats(s, curves, est.t, *fo);
+  seg.stats.seconds_estimate = t_est;
+  apply_flats(s, seg);
+  std::vector<uint8_t> frozen(s.stick_count());
+  for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = seg.region[v] >= 0;
+  st.press = press(s, curves, po, frozen, seg.barrier);
+  st.flats = seg.stats;
+  if (out) *out = std::move(seg);
+  return st;
+}
+
+void add_region_attributes(Mesh& mesh, const FlatSegmentation& f, bool colors) {
+  const size_t n = mesh.vertex_count();
+  if (f.region.size() != n) throw std::invalid_argument("add_region_attributes: segmentation does not match the mesh");
+  MeshAttribute region{"region", ScalarType::i32, std::vector<double>(n)};
+  MeshAttribute junction{"junction", ScalarType::u8, std::vector<double>(n)};
+  for (size_t v = 0; v < n; ++v) {
+    region.values[v] = f.region[v];
+    junction.values[v] = f.junction.empty() ? 0 : f.junction[v];
+  }
+  mesh.vertex_attributes.push_back(std::move(region));
+  mesh.vertex_attributes.push_back(std::move(junction));
+  if (!colors) return;
+  mesh.colors.resize(n);
+  for (size_t v = 0; v < n; ++v) {
+    const int32_t r = f.region[v];
+    if (!f.junction.empty() && f.junction[v])
+      mesh.colors[v] = {255, 140, 0, 255};
+    else if (r < 0)
+      mesh.colors[v] = {170, 170, 170, 255};
+    else {
+      // Golden-angle hues: neighbouring ids get distant colours.
+      const double h = std::fmod(double(r) * 137.50776, 360.0) / 60.0;
+      const double x = 1 - std::abs(std::fmod(h, 2.0) - 1);
+      double rgb[3] = {0, 0, 0};
+      const int sector = int(h);
+      const int order[6][2] = {{0, 1}, {1, 0}, {1, 2}, {2, 1}, {2, 0}, {0, 2}};  // HSV sectors: (full, rising)
+      rgb[order[sector][0]] = 1;
+      rgb[order[sector][1]] = x;
+      for (double& c : rgb) c = 0.25 + 0.65 * c;
+      mesh.colors[v] = {uint8_t(255 * rgb[0]), uint8_t(255 * rgb[1]), uint8_t(255 * rgb[2]), 255};
+    }
+  }
+}
+
+}  // namespace voxpress

@@ -1,0 +1,295 @@
+// Flats (plane voting) and junctions: the planes found on solids whose
+// planar faces are known exactly, the guarantees of the pipeline on the
+// property corpus, determinism, and the stick-level invariants.
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "test_util.h"
+#include "voxpress/eval/checks.h"
+#include "voxpress/eval/metrics.h"
+#include "voxpress/eval/truth.h"
+#include "voxpress/eval/voxelize.h"
+#include "voxpress/smooth/flats.h"
+
+namespace voxpress {
+namespace {
+
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / std::numbers::pi;
+}
+
+struct FlatRun {
+  GeneratedShape shape;
+  StickSurface surface;
+  FlatSegmentation seg;
+  std::vector<PlanarFace> faces;  // physical
+};
+
+FlatRun run(ShapeKind kind, int64_t res, int seed) {
+  FlatRun r;
+  GenerateOptions go;
+  go.res = res;
+  go.rotation = parse_rotation("random:" + std::to_string(seed));
+  r.shape = generate_shape(kind, go);
+  for (const PlanarFace& f : shape_planar_faces(kind)) r.faces.push_back(transform_face(f, r.shape.linear, r.shape.translation));
+  r.surface = extract_sticks(r.shape.volume);
+  const SliceCurves curves = build_slice_curves(r.surface);
+  const FlatOptions fo;
+  press_with_flats(r.surface, curves, {}, &fo, &r.seg);
+  return r;
+}
+
+// Index of the true face a flat matches (normal within 1 degree, offset
+// within half a cell), or -1.
+int match(const Flat& f, const std::vector<PlanarFace>& faces) {
+  for (size_t i = 0; i < faces.size(); ++i)
+    if (angle_deg(f.normal, faces[i].normal) < 1 && std::abs(f.offset - faces[i].offset) < 0.5) return int(i);
+  return -1;
+}
+
+// Every guarantee of the output: closed, manifold, oriented, no sample on
+// the wrong side; frozen vertices exactly on their planes.
+void expect_guarantees(const StickSurface& s, const FlatSegmentation& seg, const BinaryVolume& v) {
+  for (double t : s.t) ASSERT_TRUE(t >= 0.01 && t <= 0.99);
+  const Mesh m = to_mesh(s);
+  const MeshCheck mc = check_mesh(m);
+  EXPECT_TRUE(mc.ok()) << (mc.problems.empty() ? "" : mc.problems[0]);
+  EXPECT_EQ(check_classification(m, v).violations, 0u);
+  ASSERT_EQ(seg.region.size(), s.stick_count());
+  for (size_t i = 0; i < s.stick_count(); ++i) {
+    if (seg.region[i] < 0) continue;
+    const Flat& f = seg.flats[size_t(seg.region[i])];
+    ASSERT_NEAR(f.index_normal.dot(s.index_position(i)), f.index_offset, 1e-9) << "frozen vertex off its plane";
+  }
+}
+
+TEST(Flats, RotatedBoxesHaveExactlySixFlatsWithinOneDegree) {
+  for (int seed = 1; seed <= 6; ++seed) {
+    SCOPED_TRACE("box 128 seed " + std::to_string(seed));
+    const FlatRun r = run(ShapeKind::box, 128, seed);
+    ASSERT_EQ(r.seg.flats.size(), 6u);
+    std::vector<int> used(6, 0);
+    for (const Flat& f : r.seg.flats) {
+      const int k = match(f, r.faces);
+      ASSERT_GE(k, 0) << "a flat matches no face of the box";
+      ++used[size_t(k)];
+    }
+    for (int u : used) EXPECT_EQ(u, 1) << "each face is found once";
+    expect_guarantees(r.surface, r.seg, r.shape.volume);
+  }
+}
+
+TEST(Flats, RotatedBoxesAt64HaveNoSpuriousFlat) {
+  // At 64^3 the pressed estimate of the box is a pillow: on 3 of these 8
+  // rotations two to four faces spread like tangent strips and are
+  // missed (docs/BENCHMARKS.md). What is found is right, and most is found.
+  size_t found = 0;
+  for (int seed = 1; seed <= 8; ++seed) {
+    SCOPED_TRACE("box 64 seed " + std::to_string(seed));
+    const FlatRun r = run(ShapeKind::box, 64, seed);
+    std::vector<int> used(6, 0);
+    for (const Flat& f : r.seg.flats) {
+      const int k = match(f, r.faces);
+      ASSERT_GE(k, 0) << "a flat matches no face of the box";
+      ++used[size_t(k)];
+    }
+    for (int u : used) EXPECT_LE(u, 1);
+    EXPECT_GE(r.seg.flats.size(), 2u);
+    found += r.seg.flats.size();
+    expect_guarantees(r.surface, r.seg, r.shape.volume);
+  }
+  EXPECT_GE(found, 36u) << "of 48 faces (38 when written)";
+}
+
+TEST(Flats, RotatedCylinderHasTwoCapsAndACurvedWall) {
+  for (int64_t res : {64, 128})
+    for (int seed = 1; seed <= 2; ++seed) {
+      SCOPED_TRACE("cylinder " + std::to_string(res) + " seed " + std::to_string(seed));
+      const FlatRun r = run(ShapeKind::cylinder, res, seed);
+      ASSERT_EQ(r.seg.flats.size(), 2u);
+      EXPECT_NE(match(r.seg.flats[0], r.faces), -1);
+      EXPECT_NE(match(r.seg.flats[1], r.faces), -1);
+      EXPECT_NE(match(r.seg.flats[0], r.faces), match(r.seg.flats[1], r.faces));
+      // The wall is curved: most of it stays fresh (its area is 2 / (2 * 0.6 / 2) = 3.3 x the caps').
+      const size_t fresh = size_t(std::count(r.seg.region.begin(), r.seg.region.end(), -1));
+      EXPECT_GT(double(fresh), 0.6 * double(r.surface.stick_count()));
+      // The caps meet the wall at 90 degrees: junctions, all next to a frozen vertex.
+      EXPECT_GT(r.seg.stats.junctions, 0u);
+      expect_guarantees(r.surface, r.seg, r.shape.volume);
+    }
+}
+
+TEST(Flats, CadPartPlanarFacesFoundNoneSpurious) {
+  // seed 1 at 128 misses the chamfer (docs/BENCHMARKS.md): the pressed
+  // estimate rounds the 12-cell-wide face from both sides, so its core
+  // bends like a cylinder strip; it is asserted separately below.
+  for (int seed = 2; seed <= 4; ++seed) {
+    SCOPED_TRACE("cad-part 128 seed " + std::to_string(seed));
+    const FlatRun r = run(ShapeKind::cad_part, 128, seed);
+    std::vector<int> found(r.faces.size(), 0);
+    for (const Flat& f : r.seg.flats) {
+      const int k = match(f, r.faces);
+      ASSERT_GE(k, 0) << "spurious flat";
+      found[size_t(k)] = 1;
+    }
+    for (size_t i = 0; i < r.faces.size(); ++i)
+      EXPECT_TRUE(found[i]) << "planar face " << i << " (area " << r.faces[i].area << ") not found";
+    expect_guarantees(r.surface, r.seg, r.shape.volume);
+  }
+  const FlatRun r = run(ShapeKind::cad_part, 128, 1);
+  size_t found = 0;
+  for (const Flat& f : r.seg.flats) {
+    ASSERT_GE(match(f, r.faces), 0) << "spurious flat";
+    ++found;
+  }
+  EXPECT_GE(found, r.faces.size() - 1);
+}
+
+TEST(Flats, OrganicShapesHaveNoFlats) {
+  for (ShapeKind k : {ShapeKind::sphere, ShapeKind::torus}) {
+    const FlatRun r = run(k, 128, 1);
+    EXPECT_TRUE(r.seg.flats.empty()) << shape_name(k);
+  }
+}
+
+// The Table 2 stages of the full pipeline on `s`: stick error of
+// "midpoint + tiles" and the evaluation of the final surface.
+struct Stages {
+  FlatSegmentation seg;
+  double tiles = 0;
+  EvalReport final_report;
+};
+Stages stages(StickSurface& s, const BinaryVolume& v, const Truth& truth) {
+  Stages st;
+  const FlatOptions fo;
+  press_with_flats(s, build_slice_curves(s), {}, &fo, &st.seg);
+  StickSurface tiles = s;
+  apply_flats(tiles, st.seg);
+  EvalOptions eo;
+  eo.volume = &v;
+  eo.samples = 50000;
+  st.tiles = *evaluate(to_mesh(tiles), truth, eo).stick_rms_vox;
+  st.final_report = evaluate(to_mesh(s), truth, eo);
+  return st;
+}
+
+TEST(Flats, FlatsMakeTheBoxMoreAccurate) {
+  GenerateOptions go;
+  go.res = 96;
+  go.rotation = parse_rotation("random:7");
+  const GeneratedShape g = generate_shape(ShapeKind::box, go);
+  const auto truth = shape_truth(g.kind, g.linear, g.translation);
+  StickSurface plain = extract_sticks(g.volume), flats = plain;
+  press_with_flats(plain, build_slice_curves(plain), {}, nullptr);
+  EvalOptions eo;
+  eo.volume = &g.volume;
+  eo.samples = 50000;
+  const double e_plain = *evaluate(to_mesh(plain), *truth, eo).stick_rms_vox;
+  const Stages st = stages(flats, g.volume, *truth);
+  const double e_tiles = st.tiles, e_flats = *st.final_report.stick_rms_vox;
+  EXPECT_LT(e_tiles, 0.2) << "midpoint + tiles (midpoint alone: 0.29)";
+  EXPECT_LT(e_flats, 0.6 * e_plain) << "flats + smoothing vs smoothing alone";
+}
+
+TEST(Flats, PropertyCorpusKeepsEveryGuarantee) {
+  FlatOptions fo;
+  fo.min_area = 4;  // small volumes: let flats happen
+  fo.min_width = 1;
+  PressOptions po;
+  po.iterations = 30;
+  for (const test::Case& c : test::property_volumes()) {
+    SCOPED_TRACE(c.name);
+    StickSurface s = extract_sticks(c.volume);
+    FlatSegmentation seg;
+    press_with_flats(s, build_slice_curves(s), po, &fo, &seg);
+    expect_guarantees(s, seg, c.volume);
+    for (size_t i = 0; i < s.stick_count(); ++i) {
+      if (seg.barrier[i]) {
+        ASSERT_GE(seg.region[i], 0) << "barriers are frozen";
+      }
+      if (seg.junction[i]) {
+        ASSERT_LT(seg.region[i], 0) << "junctions are fresh";
+      }
+    }
+  }
+}
+
+TEST(Flats, SameResultForOneAndManyThreads) {
+  GenerateOptions go;
+  go.res = 72;
+  go.rotation = parse_rotation("random:3");
+  const GeneratedShape g = generate_shape(ShapeKind::cad_part, go);
+  StickSurface one = extract_sticks(g.volume), many = one;
+  const SliceCurves curves = build_slice_curves(one);
+  const FlatOptions fo;
+  FlatSegmentation s1, s2;
+  {
+    tbb::task_arena arena(1);
+    arena.execute([&] { press_with_flats(one, curves, {}, &fo, &s1); });
+  }
+  {
+    tbb::task_arena arena(std::max(2, tbb::info::default_concurrency()));
+    arena.execute([&] { press_with_flats(many, curves, {}, &fo, &s2); });
+  }
+  EXPECT_EQ(one.t, many.t);
+  EXPECT_EQ(s1.region, s2.region);
+  EXPECT_EQ(s1.junction, s2.junction);
+  EXPECT_GT(s1.flats.size(), 0u);
+}
+
+TEST(Flats, JunctionAngleOptionControlsJunctions) {
+  const FlatRun r = run(ShapeKind::cylinder, 64, 1);
+  StickSurface s = extract_sticks(r.shape.volume);
+  const SliceCurves curves = build_slice_curves(s);
+  FlatOptions fo;
+  fo.junction_angle = 180;  // no angle is sharp: only vertices squeezed between flats remain junctions
+  FlatSegmentation seg;
+  press_with_flats(s, curves, {}, &fo, &seg);
+  EXPECT_GT(r.seg.stats.junctions, 0u);
+  EXPECT_LT(seg.stats.junctions * 10, r.seg.stats.junctions);
+  EXPECT_EQ(seg.flats.size(), 2u);
+}
+
+TEST(Flats, RegionAttributesAndColours) {
+  const FlatRun r = run(ShapeKind::box, 48, 2);
+  Mesh m = to_mesh(r.surface);
+  add_region_attributes(m, r.seg, true);
+  const MeshAttribute* region = m.vertex_attribute("region");
+  const MeshAttribute* junction = m.vertex_attribute("junction");
+  ASSERT_TRUE(region && junction);
+  ASSERT_EQ(m.colors.size(), m.vertex_count());
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    ASSERT_EQ(region->values[v], double(r.seg.region[v]));
+    if (r.seg.region[v] >= 0 && r.seg.region[v] != r.seg.region[0]) {
+      EXPECT_TRUE(r.seg.region[0] < 0 || m.colors[v] != m.colors[0]) << "different flats, different colours";
+    }
+  }
+}
+
+TEST(Flats, FandiskStagesBeatTheMidpoint) {
+  VOXPRESS_REQUIRE_SHARED_DATA();
+  const Mesh model = read_mesh(test::shared_data() + "/meshes/fandisk.off");
+  VoxelizeOptions vo;
+  vo.res = 128;
+  vo.rotation = parse_rotation("random:1");
+  const Voxelized v = voxelize(model, vo);
+  Mesh phys = model;
+  for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
+  const auto truth = mesh_truth(std::move(phys), "fandisk");
+  StickSurface s = extract_sticks(v.volume);
+  const Stages st = stages(s, v.volume, *truth);
+  const FlatSegmentation& seg = st.seg;
+  const double e_tiles = st.tiles;
+  const EvalReport& final_report = st.final_report;
+  EXPECT_GE(seg.flats.size(), 5u) << "fandisk has 5 planar faces above the minimum size";
+  EXPECT_LT(e_tiles, 0.25);
+  EXPECT_LT(*final_report.stick_rms_vox, e_tiles);
+  EXPECT_EQ(final_report.classification_violations.value_or(1), 0u);
+  EXPECT_TRUE(final_report.mesh.ok());
+}
+
+}  // namespace
+}  // namespace voxpress
