@@ -801,7 +801,9 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const auto t0 = std::chrono::steady_clock::now();
   StickSurface est = s;
   PressOptions eo = po;
-  eo.iterations = std::max(po.iterations, 60);  // the estimate needs a converged surface
+  eo.iterations = fo->estimate_iterations;  // fixed: the flats do not depend on po.iterations
+  eo.tolerance = 0;
+  eo.progress = nullptr;
   press(est, curves, eo);
   const double t_est = seconds_since(t0);
   FlatSegmentation seg = find_flats(s, curves, est.t, *fo);

@@ -149,32 +149,6 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
   // Pass 2: the Laplacian of the Laplacian, interpolated at the same places.
   const auto lap_at = [&](const Where& x) { return Vec2(lap[x.k] + x.f * (lap[next(x.k)] - lap[x.k])); };
   for (size_t i = 0; i < n; ++i) w.disp[i] = s2 * (lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
-  if (closed || !resample) return;
-  // An open piece ends at two feature barriers (Section 4, Fig. 7): a vertex
-  // closer than d to an end does not use the bilaplacian (its virtual
-  // neighbours would be clamped at the feature); it aligns with its smooth
-  // side, moving towards 2 P(a + d) - P(a + 2 d), the line through the two
-  // points at arc lengths d and 2 d further in, extended back to it. When
-  // the piece is too short for that, the clamped bilaplacian stays.
-  double* arc = w.inv.data();  // reuse: arc length from the start (inv is no longer needed)
-  arc[0] = 0;
-  for (size_t i = 1; i < n; ++i) arc[i] = arc[i - 1] + len[i - 1];
-  const double total = arc[n - 1];
-  const auto at = [&](double s) {  // point at arc length s (binary search)
-    const size_t k = size_t(std::upper_bound(arc, arc + n, s) - arc);
-    if (k >= n) return p[n - 1];
-    if (k == 0) return p[0];
-    const double l = len[k - 1];
-    return Vec2(l > 0 ? Vec2(p[k - 1] + (s - arc[k - 1]) / l * (p[k] - p[k - 1])) : p[k - 1]);
-  };
-  for (size_t i = 1; i + 1 < n; ++i) {
-    const double a = arc[i], b = total - a;
-    if (a >= d && b >= d) continue;
-    if (a <= b && b >= 2 * d)
-      w.disp[i] = 2 * at(a + d) - at(a + 2 * d) - p[i];
-    else if (b < a && a >= 2 * d)
-      w.disp[i] = 2 * at(a - d) - at(a - 2 * d) - p[i];
-  }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {

@@ -1,6 +1,6 @@
 // voxpress/smooth/flats.h — flats by plane voting (max tiles) and junction
 // points (Pressing, Chica et al., Section 3), and the Pressing pipeline that
-// uses them (Section 4, last paragraph, Fig. 7).
+// uses them (Section 4, last paragraph).
 //
 // A flat is a plane together with a connected set of sticks it stabs (a
 // plane stabs a stick when it separates the stick's two samples). Its
@@ -39,9 +39,11 @@
 // in V's 2-ring is compared with F's normal; above `junction_angle` V is a
 // junction (the edge crosses a sharp feature); so is a fresh vertex with
 // fewer than three fresh vertices in its 2-ring (squeezed between flats,
-// whatever the angle). Frozen vertices next to a
-// junction along a slice curve become barriers for the smoothing, which then
-// aligns the vertices within d of them with their smooth side (Fig. 7).
+// whatever the angle). Frozen vertices next to a junction along a slice
+// curve become barriers: the smoothing cuts the curves there, so no virtual
+// neighbour is taken across the sharp feature (the open pieces keep a
+// clamped bilaplacian; the paper's Fig. 7 alignment was tried and dropped,
+// docs/ARCHITECTURE.md).
 #pragma once
 
 #include <cstdint>
@@ -64,6 +66,7 @@ struct FlatOptions {
   double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
   int rim_rings = 2;           ///< surface rings added around the core
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
+  int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
   Progress* progress = nullptr;
 };
 
