@@ -509,7 +509,6 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
   return S;
 }
 
-Vec3 to_physical_normal(const Mat3& Minv_t, const Vec3& n) { return (Minv_t * n).normalized(); }
 
 }  // namespace
 
@@ -585,16 +584,13 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   const Mat3 M = s.lattice.index_to_physical_matrix();
   const Mat3 Minv_t = M.inverse().transpose();
   std::vector<uint32_t> seeds;
-  std::vector<uint8_t> voting(count.begin(), count.end());
   auto unvote = [&](uint32_t v) {  // drops the stick's votes from the accumulator
-    if (!voting[v]) return;
-    voting[v] = 0;
-    uint64_t mine[kMaxVotes];
-    const int k = votes_of(S.nrm[v], S.x[v], cone, mine);
-    for (int q = 0; q < k; ++q) {
-      const size_t cc = cell_of(mine[q]);
-      if (cc < cell_key.size() && cell_key[cc] == mine[q] && cell_count[cc] > 0) --cell_count[cc];
+    for (uint32_t q = 0; q < count[v]; ++q) {
+      const uint64_t key = keys[v * kMaxVotes + q];
+      const size_t cc = cell_of(key);
+      if (cell_key[cc] == key && cell_count[cc] > 0) --cell_count[cc];
     }
+    count[v] = 0;
   };
   while (!heap.empty()) {
     const auto [cnt, neg] = heap.top();
@@ -625,12 +621,10 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     Flat f;
     f.index_normal = P.n;
     f.index_offset = P.c;
-    f.normal = to_physical_normal(Minv_t, P.n);
     // Physical plane: n_i . M^-1 (x - origin) = c.
     const Vec3 np = Minv_t * P.n;
+    f.normal = np.normalized();
     f.offset = (P.c + np.dot(s.lattice.origin)) / np.norm();
-    f.sticks = members.size();
-    const double det_m = std::abs(M.determinant());
     for (uint32_t v : members) {
       seg.region[v] = id;
       // Members were stabbed with the margin; only rounding could put t a
@@ -638,11 +632,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
       if (!(fi < 0 && fo > 0)) throw std::logic_error("find_flats: a flat's plane does not cross one of its sticks");
       seg.t[v] = std::clamp(-fi / (fo - fi), o.margin, 1 - o.margin);
-      // Index-space area -> physical: scaled by |det M| |M^-T n| for a plane of normal n.
-      f.area_cells += S.area[v];
       unvote(v);
     }
-    f.area = f.area_cells * det_m * np.norm();
     seg.flats.push_back(f);
     progress.add(1);
   }
@@ -739,14 +730,13 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     }
     if (moves.empty()) break;
     for (const auto& [v, f] : moves) {
-      if (seg.region[v] >= 0) --seg.flats[size_t(seg.region[v])].sticks;
       seg.region[v] = f;
       seg.t[v] = crossing(S, v, planes[size_t(f)], o.margin);
-      ++seg.flats[size_t(f)].sticks;
     }
   }
   detect_junctions();
-  // Final sizes (the extension moved sticks between flats).
+  // Sizes, once the extension has settled the members. Index-space area ->
+  // physical: |det M| |M^-T n| for a plane of unit index normal n.
   for (Flat& f : seg.flats) f.sticks = 0, f.area_cells = 0;
   for (size_t v = 0; v < n; ++v)
     if (seg.region[v] >= 0) {
