@@ -13,34 +13,22 @@ struct ExtractCmd {
 void run_extract(const ExtractCmd& c, const Global& g) {
   mesh_format_from_path(c.output);  // fail on a bad extension before any work
   Stopwatch clock;
-  const BinaryVolume volume = load_binary(c.input, c.in, g);
-  const double t_read = clock.seconds();
   ProgressBar bar(!g.quiet);
-  ExtractOptions eo;
-  eo.progress = bar.get();
-  eo.max_bytes = g.memory_limit();
-  ExtractStats st;
-  const StickSurface surface = extract_sticks(volume, eo, &st);
-  const Mesh mesh = to_mesh(surface);
+  const VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());
+  const Mesh mesh = to_mesh(vs.surface);
   const double t_extract = clock.seconds();
-  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), "extracted") : nlohmann::json();
+  const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), "extracted") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
   if (!g.quiet)
     std::fprintf(stderr, "%s: %zu vertices, %zu triangles\n", c.output.c_str(), mesh.vertex_count(), mesh.face_count());
   if (!c.stats_json.empty()) {
-    nlohmann::json j;
-    j["command"] = "extract";
-    j["input"] = c.input;
-    j["output"] = c.output;
-    j["lattice"] = lattice_json(volume.lattice);
-    j["counts"] = {{"samples", st.samples}, {"sticks", st.sticks}, {"vertices", mesh.vertex_count()},
-                   {"triangles", mesh.face_count()}};
-    j["seconds"] = {{"read", t_read},
-                    {"sticks", st.seconds_sticks},
-                    {"triangles", st.seconds_triangles},
-                    {"extract_total", t_extract - t_read},
+    nlohmann::json j = surface_stats_json("extract", c.input, c.output, vs, mesh);
+    j["seconds"] = {{"read", vs.seconds_read},
+                    {"sticks", vs.stats.seconds_sticks},
+                    {"triangles", vs.stats.seconds_triangles},
+                    {"extract_total", t_extract - vs.seconds_read},
                     {"total", clock.seconds()}};
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;

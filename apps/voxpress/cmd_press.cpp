@@ -49,15 +49,9 @@ void run_press(const PressCmd& c, const Global& g) {
   if (!(c.flats.tolerance > 0) || !(c.flats.max_bend > 0) || !(c.flats.min_width >= 0))
     throw UsageError("--flat-tolerance and --flat-bend must be > 0, --flat-width >= 0");
   Stopwatch clock;
-  const BinaryVolume volume = load_binary(c.input, c.in, g);
-  const double t_read = clock.seconds();
   ProgressBar bar(!g.quiet);
-  ExtractOptions eo;
-  eo.progress = bar.get();
-  eo.max_bytes = g.memory_limit();
-  ExtractStats es;
-  StickSurface surface = extract_sticks(volume, eo, &es);
-  const double t_extract = clock.seconds();
+  VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());
+  StickSurface& surface = vs.surface;
   PressOptions o = po;
   o.progress = bar.get();
   FlatOptions fo = c.flats;
@@ -68,7 +62,7 @@ void run_press(const PressCmd& c, const Global& g) {
   const PressStats& ps = fs.press;
   Mesh mesh = to_mesh(surface);
   if (!c.no_flats) add_region_attributes(mesh, seg, c.color_regions);
-  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), "pressed") : nlohmann::json();
+  const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), "pressed") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
@@ -77,17 +71,11 @@ void run_press(const PressCmd& c, const Global& g) {
                  c.output.c_str(), mesh.vertex_count(), mesh.face_count(), seg.flats.size(), seg.frozen_count(),
                  size_t(seg.stats.junctions), ps.iterations, ps.last_max_change);
   if (!c.stats_json.empty()) {
-    nlohmann::json j;
-    j["command"] = "press";
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, vs, mesh);
     j["method"] = "pressing";
-    j["input"] = c.input;
-    j["output"] = c.output;
-    j["lattice"] = lattice_json(volume.lattice);
-    j["counts"] = {{"samples", es.samples}, {"sticks", es.sticks}, {"vertices", mesh.vertex_count()},
-                   {"triangles", mesh.face_count()}};
     j["pressing"] = press_stats_json(ps, po);
     if (!c.no_flats) j["flats"] = flats_json(seg, fo);
-    j["seconds"] = {{"read", t_read}, {"extract", t_extract - t_read}, {"press", ps.seconds}, {"total", clock.seconds()}};
+    j["seconds"] = {{"read", vs.seconds_read}, {"extract", vs.seconds_extract}, {"press", ps.seconds}, {"total", clock.seconds()}};
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
     write_json(c.stats_json, j);

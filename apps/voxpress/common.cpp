@@ -111,6 +111,31 @@ BinaryVolume load_binary(const std::string& path, const InputOptions& in, const 
   return b;
 }
 
+VolumeSurface load_surface(const std::string& path, const InputOptions& in, const Global& g, Progress* progress) {
+  VolumeSurface vs;
+  Stopwatch clock;
+  vs.volume = load_binary(path, in, g);
+  vs.seconds_read = clock.seconds();
+  ExtractOptions eo;
+  eo.progress = progress;
+  eo.max_bytes = g.memory_limit();
+  vs.surface = extract_sticks(vs.volume, eo, &vs.stats);
+  vs.seconds_extract = clock.seconds() - vs.seconds_read;
+  return vs;
+}
+
+nlohmann::json surface_stats_json(const char* command, const std::string& input, const std::string& output,
+                                  const VolumeSurface& vs, const Mesh& mesh) {
+  nlohmann::json j;
+  j["command"] = command;
+  j["input"] = input;
+  j["output"] = output;
+  j["lattice"] = lattice_json(vs.volume.lattice);
+  j["counts"] = {{"samples", vs.stats.samples}, {"sticks", vs.stats.sticks}, {"vertices", mesh.vertex_count()},
+                 {"triangles", mesh.face_count()}};
+  return j;
+}
+
 void PressCli::bind(CLI::App& cmd) {
   auto* g = cmd.add_option_group("smoothing", "Pressing (constrained bilaplacian smoothing)");
   g->add_option("--iterations", options.iterations, "Maximum iterations")->capture_default_str();

@@ -62,6 +62,20 @@ ScalarVolume load_volume(const std::string& path, const InputOptions& in, const 
 /// Reads, binarises and checks that the volume is neither empty nor full.
 BinaryVolume load_binary(const std::string& path, const InputOptions& in, const Global& g);
 
+/// A volume read, binarised and turned into its stick surface: the first
+/// steps of `extract` and `press`.
+struct VolumeSurface {
+  BinaryVolume volume;
+  StickSurface surface;
+  ExtractStats stats;
+  double seconds_read = 0, seconds_extract = 0;
+};
+VolumeSurface load_surface(const std::string& path, const InputOptions& in, const Global& g, Progress* progress);
+/// The --stats-json fields `extract` and `press` share: command, input,
+/// output, lattice and counts.
+nlohmann::json surface_stats_json(const char* command, const std::string& input, const std::string& output,
+                                  const VolumeSurface& vs, const Mesh& mesh);
+
 /// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).
 Vec3 parse_vec3(const std::string& text, const std::string& option);
 
