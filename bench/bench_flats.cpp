@@ -3,7 +3,7 @@
 // shapes and shared models, randomly rotated.
 //   build/bench/bench_flats                      # the table in docs/BENCHMARKS.md
 //   build/bench/bench_flats --shape box --res 64 --seeds 20
-//   build/bench/bench_flats --model ../shared/data/meshes/fandisk.off --res 128 --seeds 3
+//   build/bench/bench_flats --model ../shared/data/meshes/fandisk.off --res 128 --seeds 3 [--split]
 // A true planar face is "found" when a flat's plane is within 1 degree and
 // half a cell of it; a flat matching no true face is "spurious". For models
 // every planar face of the mesh counts (a coarsely tessellated curved face
@@ -38,7 +38,7 @@ double stick_rms(const StickSurface& s, const Truth& truth, const BinaryVolume& 
   return evaluate(to_mesh(s), truth, eo).stick_rms_vox.value_or(NAN);
 }
 
-void run(const Case& c, const FlatOptions& fo, int iterations, bool header) {
+void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool split) {
   if (header)
     std::printf("| case | flats | true faces >= min | found | spurious | worst angle (deg) | estimate s | detect s | "
                 "junctions s | stick: midpoint | + tiles | + smoothing | r->t RMS | normal err (deg) | violations | "
@@ -53,7 +53,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header) {
   StickSurface tiles = s;
   apply_flats(tiles, seg);
   const double with_tiles = stick_rms(tiles, *c.truth, c.volume);
-  if (std::getenv("VP_SPLIT")) {
+  if (split) {
     // Stick error split by vertex class: frozen, junction, fresh.
     double sum[3] = {0, 0, 0};
     size_t cnt[3] = {0, 0, 0};
@@ -93,7 +93,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header) {
       bool hit = false;
       for (const Flat& f : seg.flats) hit |= matches(f, t);
       found += hit;
-      if (!hit && std::getenv("VP_SPLIT"))
+      if (!hit && split)
         std::fprintf(stderr, "missed face: area %.0f cells^2 normal (%.3f %.3f %.3f)\n", t.area / (cell * cell), t.normal.x(), t.normal.y(), t.normal.z());
     }
     for (const Flat& f : seg.flats) {
@@ -125,6 +125,8 @@ int main(int argc, char** argv) {
   int64_t res = 0;
   int seeds = 0, iterations = 100;
   FlatOptions fo;
+  bool split = false;
+  app.add_flag("--split", split, "Also print (stderr) the stick error by vertex class, missed faces, a model's planar faces");
   app.add_option("--shape", shape, "box | cylinder | cad-part | sphere | torus");
   app.add_option("--model", model, "a closed mesh to voxelize");
   app.add_option("--res", res);
@@ -179,7 +181,7 @@ int main(int argc, char** argv) {
         Voxelized v = voxelize(m, vo, j.model);
         Mesh phys = m;
         for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
-        if (std::getenv("VP_SPLIT")) {
+        if (split) {
           double total = 0, planar = 0;
           for (const PlanarFace& f : planar_faces(phys)) {
             total += f.area;
@@ -195,7 +197,7 @@ int main(int argc, char** argv) {
         c.volume = std::move(v.volume);
         c.name = std::filesystem::path(j.model).stem().string() + " " + std::to_string(j.res) + " seed " + std::to_string(seed);
       }
-      run(c, fo, iterations, header);
+      run(c, fo, iterations, header, split);
       header = false;
     }
   return 0;
