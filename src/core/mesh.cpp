@@ -28,6 +28,9 @@ void Mesh::validate(const std::string& source) const {
       if (v >= nv)
         throw InputError(source, "face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " but there are " +
                                      std::to_string(nv) + " vertices");
+  for (size_t e = 0; e < edges.size(); ++e)
+    if (edges[e][0] >= nv || edges[e][1] >= nv)
+      throw InputError(source, "edge " + std::to_string(e) + " uses a vertex beyond the " + std::to_string(nv) + " vertices");
   if (!normals.empty() && normals.size() != nv) throw InputError(source, "normal count differs from vertex count");
   if (!colors.empty() && colors.size() != nv) throw InputError(source, "color count differs from vertex count");
   for (const auto& a : vertex_attributes)
@@ -102,6 +105,10 @@ size_t weld_identical_vertices(Mesh& mesh) {
       a.values.swap(vals);
     }
   mesh.triangles.swap(tris);
+  std::vector<std::array<uint32_t, 2>> edges;
+  for (const auto& e : mesh.edges)
+    if (remap[e[0]] != remap[e[1]]) edges.push_back({remap[e[0]], remap[e[1]]});
+  mesh.edges.swap(edges);
   return removed;
 }
 

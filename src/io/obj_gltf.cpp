@@ -2,6 +2,7 @@
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -52,6 +53,17 @@ Mesh read_obj(const std::string& path, uint64_t max_bytes) {
       offset += n;
     }
   }
+  for (const auto& sh : shapes) {
+    size_t offset = 0;
+    for (const int n : sh.lines.num_line_vertices) {
+      for (int q = 0; q + 1 < n; ++q) {
+        const int a = sh.lines.indices[offset + size_t(q)].vertex_index, b = sh.lines.indices[offset + size_t(q) + 1].vertex_index;
+        if (a < 0 || b < 0 || size_t(a) >= nv || size_t(b) >= nv) throw InputError(path, "OBJ line uses a missing vertex");
+        m.edges.push_back({uint32_t(a), uint32_t(b)});
+      }
+      offset += size_t(n);
+    }
+  }
   if (m.triangles.empty()) throw InputError(path, "the OBJ file holds no faces");
   m.validate(path);
   return m;
@@ -75,15 +87,29 @@ void write_obj(const std::string& path, const Mesh& m) {
     const bool vn = !m.normals.empty();
     if (vn)
       for (const Vec3& n : m.normals) buf += "vn " + fmt(n.x()) + " " + fmt(n.y()) + " " + fmt(n.z()) + "\n";
-    for (const Triangle& t : m.triangles) {
+    // Faces with a "region" attribute are grouped per region (g flat_<id>,
+    // g curved), in a stable order; labelled edges become "l" records.
+    std::vector<size_t> order(m.triangles.size());
+    for (size_t f = 0; f < order.size(); ++f) order[f] = f;
+    const MeshAttribute* region = m.face_attribute("region");
+    if (region)
+      std::stable_sort(order.begin(), order.end(),
+                       [&](size_t a, size_t b) { return region->values[a] < region->values[b]; });
+    for (size_t k = 0; k < order.size(); ++k) {
+      if (region && (k == 0 || region->values[order[k]] != region->values[order[k - 1]])) {
+        const double r = region->values[order[k]];
+        buf += r < 0 ? std::string("g curved\n") : "g flat_" + std::to_string(int64_t(r)) + "\n";
+      }
       buf += "f";
-      for (uint32_t i : t) buf += " " + std::to_string(i + 1) + (vn ? "//" + std::to_string(i + 1) : "");
+      for (uint32_t i : m.triangles[order[k]]) buf += " " + std::to_string(i + 1) + (vn ? "//" + std::to_string(i + 1) : "");
       buf += "\n";
       if (buf.size() > (1 << 20)) {
         out << buf;
         buf.clear();
       }
     }
+    if (!m.edges.empty()) buf += "g sharp_edges\n";
+    for (const auto& e : m.edges) buf += "l " + std::to_string(e[0] + 1) + " " + std::to_string(e[1] + 1) + "\n";
     out << buf;
   });
 }

@@ -5,7 +5,8 @@
 // red/green/blue[/alpha] colours, anything else a vertex attribute; a "face"
 // list named vertex_indices (or vertex_index) gives polygons, fanned into
 // triangles, and its scalar properties become face attributes (copied to
-// each triangle of a polygon). Other elements (edges, materials) are skipped.
+// each triangle of a polygon); "edge" vertex1/vertex2 become labelled edges.
+// Other elements (materials, ...) are skipped.
 // Counts are checked against the bytes present before anything is allocated.
 #include <algorithm>
 #include <bit>
@@ -294,6 +295,33 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
           for (size_t a = 0; a < other.size(); ++a) m.face_attributes[a].values.push_back(rec[size_t(other[a])]);
         }
       }
+    } else if (e.name == "edge" && m.edges.empty()) {
+      // Labelled edges (vertex1, vertex2; other properties skipped).
+      int i1 = -1, i2 = -1;
+      for (int k = 0; k < int(e.props.size()); ++k) {
+        if (e.props[size_t(k)].list) continue;
+        if (e.props[size_t(k)].name == "vertex1") i1 = k;
+        if (e.props[size_t(k)].name == "vertex2") i2 = k;
+      }
+      check_limit(path, e.count * 8, max_bytes, "the edges");
+      std::vector<double> rec(e.props.size());
+      for (uint64_t r = 0; r < e.count; ++r) {
+        for (size_t k = 0; k < e.props.size(); ++k) {
+          const Property& p = e.props[k];
+          if (p.list) {
+            const double nd = cur.read(p.count_type);
+            if (nd < 0 || nd > 1e9) throw InputError(path, "invalid list length in element 'edge'");
+            for (uint64_t q = 0; q < uint64_t(nd); ++q) cur.read(p.type);
+          } else {
+            rec[k] = cur.read(p.type);
+          }
+        }
+        if (i1 < 0 || i2 < 0) continue;
+        const double a = rec[size_t(i1)], b = rec[size_t(i2)];
+        if (a < 0 || b < 0 || a >= 4294967295.0 || b >= 4294967295.0 || a != std::floor(a) || b != std::floor(b))
+          throw InputError(path, "edge " + std::to_string(r) + " has an invalid vertex index");
+        m.edges.push_back({uint32_t(a), uint32_t(b)});
+      }
     } else {
       for (uint64_t r = 0; r < e.count; ++r)
         for (const Property& p : e.props) {
@@ -322,6 +350,7 @@ void write_ply(const std::string& path, const Mesh& m, bool binary) {
   for (const auto& a : m.vertex_attributes) h << "property " << ply_name(a.type) << " " << a.name << "\n";
   h << "element face " << m.triangles.size() << "\nproperty list uchar int vertex_indices\n";
   for (const auto& a : m.face_attributes) h << "property " << ply_name(a.type) << " " << a.name << "\n";
+  if (!m.edges.empty()) h << "element edge " << m.edges.size() << "\nproperty int vertex1\nproperty int vertex2\n";
   h << "end_header\n";
   const std::string header = h.str();
   write_stream_atomically(path, [&](std::ostream& out) {
@@ -363,6 +392,12 @@ void write_ply(const std::string& path, const Mesh& m, bool binary) {
       put_typed(ScalarType::u8, 3);
       for (uint32_t i : m.triangles[f]) put_typed(ScalarType::i32, double(i));
       for (const auto& a : m.face_attributes) put_typed(a.type, a.values[f]);
+      if (!binary) buf.push_back('\n');
+      if (buf.size() > (1 << 20)) flush();
+    }
+    for (const auto& e : m.edges) {
+      put_typed(ScalarType::i32, double(e[0]));
+      put_typed(ScalarType::i32, double(e[1]));
       if (!binary) buf.push_back('\n');
       if (buf.size() > (1 << 20)) flush();
     }

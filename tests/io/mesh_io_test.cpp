@@ -36,6 +36,7 @@ TEST(MeshIO, PlyRoundTripKeepsEverything) {
   MeshAttribute quality{"quality", ScalarType::f32, {}};
   for (size_t f = 0; f < m.triangles.size(); ++f) quality.values.push_back(double(float(0.25 * double(f))));
   m.face_attributes.push_back(quality);
+  m.edges = {{0, 1}, {1, 2}, {5, 3}};
   for (bool ascii : {false, true}) {
     MeshWriteOptions o;
     o.ascii = ascii;
@@ -50,7 +51,30 @@ TEST(MeshIO, PlyRoundTripKeepsEverything) {
     EXPECT_EQ(r.vertex_attribute("region")->type, ScalarType::i32);
     ASSERT_TRUE(r.face_attribute("quality"));
     EXPECT_EQ(r.face_attribute("quality")->values, quality.values);
+    EXPECT_EQ(r.edges, m.edges);
   }
+}
+
+TEST(MeshIO, ObjGroupsRegionsAndWritesEdgesAsLines) {
+  test::TempDir tmp;
+  Mesh m = sample_mesh();
+  MeshAttribute region{"region", ScalarType::i32, {}};
+  for (size_t f = 0; f < m.triangles.size(); ++f) region.values.push_back(double(int(f % 3) - 1));
+  m.face_attributes.push_back(region);
+  m.edges = {{0, 1}, {2, 3}};
+  write_mesh(tmp.path("m.obj"), m);
+  const std::string text = test::read_file(tmp.path("m.obj"));
+  EXPECT_NE(text.find("g curved\n"), std::string::npos);
+  EXPECT_NE(text.find("g flat_0\n"), std::string::npos);
+  EXPECT_NE(text.find("g flat_1\n"), std::string::npos);
+  const Mesh r = read_mesh(tmp.path("m.obj"));
+  EXPECT_EQ(r.face_count(), m.face_count());
+  EXPECT_EQ(r.edges, m.edges);
+  // An edge naming a missing vertex is refused.
+  Mesh bad = m;
+  bad.edges.push_back({0, uint32_t(m.vertex_count())});
+  EXPECT_THROW(write_mesh(tmp.path("bad.ply"), bad), InputError);
+  EXPECT_FALSE(fs::exists(tmp.path("bad.ply")));
 }
 
 TEST(MeshIO, ObjOffStlRoundTrips) {

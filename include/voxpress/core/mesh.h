@@ -33,13 +33,16 @@ struct Mesh {
   std::vector<std::array<uint8_t, 4>> colors;        ///< optional, per vertex, RGBA
   std::vector<MeshAttribute> vertex_attributes;      ///< optional, each with #V values
   std::vector<MeshAttribute> face_attributes;        ///< optional, each with #F values
+  /// Optional labelled edges: the sharp feature curves, as vertex pairs
+  /// (PLY "edge" elements, OBJ "l" records).
+  std::vector<std::array<uint32_t, 2>> edges;
 
   size_t vertex_count() const { return positions.size(); }
   size_t face_count() const { return triangles.size(); }
   /// Attribute by name, or nullptr.
   const MeshAttribute* vertex_attribute(const std::string& name) const;
   const MeshAttribute* face_attribute(const std::string& name) const;
-  /// Throws InputError(source, ...) if an index is out of range or an
+  /// Throws InputError(source, ...) if an index (face or edge) is out of range or an
   /// attribute has the wrong length.
   void validate(const std::string& source = {}) const;
 };
