@@ -47,6 +47,20 @@ std::string shared_data() {
   return fs::exists(p / "README.md") ? fs::canonical(p).string() : "";
 }
 
+VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int seed) {
+  const Mesh model = read_mesh(shared_data() + "/meshes/" + file);
+  VoxelizeOptions vo;
+  vo.res = res;
+  vo.rotation = parse_rotation("random:" + std::to_string(seed));
+  Voxelized v = voxelize(model, vo);
+  Mesh phys = model;
+  for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
+  VoxelizedModel out;
+  out.truth = mesh_truth(std::move(phys), file);
+  out.volume = std::move(v.volume);
+  return out;
+}
+
 uint64_t Rng::next() {
   uint64_t z = (s_ += 0x9e3779b97f4a7c15ull);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;

@@ -7,9 +7,12 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "voxpress/eval/truth.h"
+#include "voxpress/eval/voxelize.h"
 #include "voxpress/voxpress.h"
 
 namespace voxpress::test {
@@ -39,6 +42,15 @@ std::string shared_data();
     if (voxpress::test::shared_data().empty())                                                   \
       GTEST_SKIP() << "../shared/data is absent (clone it beside the repository to run this)"; \
   } while (0)
+
+/// A model from ../shared/data/meshes voxelized at `res` with rotation
+/// random:seed, and its exact truth in the volume's physical frame (the
+/// caller checks that the shared data is present).
+struct VoxelizedModel {
+  BinaryVolume volume;
+  std::unique_ptr<Truth> truth;
+};
+VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int seed);
 
 /// Deterministic generator (splitmix64), independent of the standard library.
 class Rng {

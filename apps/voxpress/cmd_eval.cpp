@@ -71,7 +71,14 @@ void run_eval(const EvalCmd& c, const Global& g) {
   if (r.classification_violations)
     std::printf("%-34s %12lu\n", "classification violations", (unsigned long)*r.classification_violations);
   std::printf("%-34s %12s\n", "mesh check", r.mesh.ok() ? "OK" : r.mesh.problems[0].c_str());
-  std::printf("%-34s %12s   (%zu true sharp-edge segments)\n", "sharp edges Hausdorff", "n/a", r.true_sharp_edges);
+  if (r.sharp_edge_hausdorff) {
+    row("sharp edges true -> labelled max", r.sharp_true_to_labelled_vox, *r.sharp_true_to_labelled);
+    row("sharp edges labelled -> true max", r.sharp_labelled_to_true_vox, *r.sharp_labelled_to_true);
+    row("sharp edges Hausdorff", r.sharp_edge_hausdorff_vox, *r.sharp_edge_hausdorff);
+  } else {
+    std::printf("%-34s %12s   (%zu true sharp-edge segments, %zu labelled)\n", "sharp edges Hausdorff", "n/a",
+                r.true_sharp_edges, r.labelled_sharp_edges);
+  }
 
   if (!c.json.empty()) {
     nlohmann::json j;
@@ -100,7 +107,14 @@ void run_eval(const EvalCmd& c, const Global& g) {
     j["mesh_ok"] = r.mesh.ok();
     j["mesh_problems"] = r.mesh.problems;
     j["true_sharp_edge_segments"] = r.true_sharp_edges;
-    j["sharp_edge_hausdorff"] = nullptr;
+    j["labelled_sharp_edges"] = r.labelled_sharp_edges;
+    auto opt = [](const std::optional<double>& x) { return x ? nlohmann::json(*x) : nlohmann::json(nullptr); };
+    j["sharp_edges"] = {{"physical", {{"true_to_labelled", opt(r.sharp_true_to_labelled)},
+                                      {"labelled_to_true", opt(r.sharp_labelled_to_true)},
+                                      {"hausdorff", opt(r.sharp_edge_hausdorff)}}},
+                        {"voxels", {{"true_to_labelled", opt(r.sharp_true_to_labelled_vox)},
+                                    {"labelled_to_true", opt(r.sharp_labelled_to_true_vox)},
+                                    {"hausdorff", opt(r.sharp_edge_hausdorff_vox)}}}};
     j["seconds"] = clock.seconds();
     write_json(c.json, j);
   }

@@ -1,4 +1,5 @@
-// voxpress press IN -o OUT: the midpoint surface smoothed by Pressing.
+// voxpress press IN -o OUT: the midpoint surface smoothed by Pressing, with
+// flats, junctions and sharp edges.
 #include <cstdio>
 
 #include "common.h"
@@ -11,7 +12,9 @@ struct PressCmd {
   InputOptions in;
   PressCli smooth;
   FlatOptions flats;
-  bool no_flats = false, color_regions = false;
+  SharpenOptions sharpen;
+  std::string features;
+  bool no_flats = false, no_sharpen = false, color_regions = false;
   bool ascii = false, check = false;
 };
 
@@ -41,8 +44,46 @@ nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
           {"seconds", {{"estimate", st.seconds_estimate}, {"detect", st.seconds_detect}, {"junctions", st.seconds_junctions}}}};
 }
 
+nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
+  return {{"chamfer_edges", st.chamfer_edges},
+          {"chamfer_triangles", st.chamfer_triangles},
+          {"inserted_vertices", st.inserted},
+          {"corner_vertices", st.corners},
+          {"fallbacks", st.fallbacks},
+          {"cut_back", st.cut_back},
+          {"sharp_edges", st.sharp_edges},
+          {"sharp_angle", o.sharp_angle},
+          {"chain_iterations", o.chain_iterations},
+          {"seconds", st.seconds}};
+}
+
+// The sharp feature curves alone: their vertices and edges, no faces.
+void write_features(const std::string& path, const Mesh& mesh) {
+  Mesh f;
+  std::vector<uint32_t> id(mesh.vertex_count(), UINT32_MAX);
+  for (const auto& e : mesh.edges) {
+    std::array<uint32_t, 2> out{};
+    for (int k = 0; k < 2; ++k) {
+      uint32_t& i = id[e[size_t(k)]];
+      if (i == UINT32_MAX) {
+        i = uint32_t(f.positions.size());
+        f.positions.push_back(mesh.positions[e[size_t(k)]]);
+      }
+      out[size_t(k)] = i;
+    }
+    f.edges.push_back(out);
+  }
+  write_mesh(path, f);
+}
+
 void run_press(const PressCmd& c, const Global& g) {
   mesh_format_from_path(c.output);  // a bad extension fails before any work
+  if (!c.features.empty()) {
+    const MeshFormat ff = mesh_format_from_path(c.features);
+    if (ff != MeshFormat::ply && ff != MeshFormat::obj) throw UsageError("--features must be a .ply or .obj file");
+    if (c.no_flats || c.no_sharpen) throw UsageError("--features needs sharpening (drop --no-flats / --no-sharpen)");
+  }
+  if (!(c.sharpen.sharp_angle >= 0 && c.sharpen.sharp_angle <= 180)) throw UsageError("--sharp-angle must be in [0, 180]");
   const PressOptions po = c.smooth.resolve();
   if (!(c.flats.min_area >= 0)) throw UsageError("--min-flat-area must be >= 0");
   if (!(c.flats.junction_angle >= 0 && c.flats.junction_angle <= 180)) throw UsageError("--junction-angle must be in [0, 180]");
@@ -60,22 +101,35 @@ void run_press(const PressCmd& c, const Global& g) {
   const SliceCurves curves = build_slice_curves(surface);
   const FeaturePressStats fs = press_with_flats(surface, curves, o, c.no_flats ? nullptr : &fo, &seg);
   const PressStats& ps = fs.press;
-  Mesh mesh = to_mesh(surface);
-  if (!c.no_flats) add_region_attributes(mesh, seg, c.color_regions);
+  Mesh mesh;
+  SharpenStats sharp;
+  if (c.no_flats || c.no_sharpen) {
+    mesh = to_mesh(surface);
+    if (!c.no_flats) add_region_attributes(mesh, seg, c.color_regions);
+  } else {
+    SharpenOptions so = c.sharpen;
+    so.colors = c.color_regions;
+    SharpenResult sr = sharpen(surface, seg, so);
+    mesh = std::move(sr.mesh);
+    sharp = sr.stats;
+  }
   const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), "pressed") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
+  if (!c.features.empty()) write_features(c.features, mesh);
   if (!g.quiet)
-    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %d iterations (last max change %.2g)\n",
+    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %zu sharp edges, %d iterations (last max change %.2g)\n",
                  c.output.c_str(), mesh.vertex_count(), mesh.face_count(), seg.flats.size(), seg.frozen_count(),
-                 size_t(seg.stats.junctions), ps.iterations, ps.last_max_change);
+                 size_t(seg.stats.junctions), mesh.edges.size(), ps.iterations, ps.last_max_change);
   if (!c.stats_json.empty()) {
     nlohmann::json j = surface_stats_json("press", c.input, c.output, vs, mesh);
     j["method"] = "pressing";
     j["pressing"] = press_stats_json(ps, po);
     if (!c.no_flats) j["flats"] = flats_json(seg, fo);
-    j["seconds"] = {{"read", vs.seconds_read}, {"extract", vs.seconds_extract}, {"press", ps.seconds}, {"total", clock.seconds()}};
+    if (!c.no_flats && !c.no_sharpen) j["sharpen"] = sharpen_json(sharp, c.sharpen);
+    j["seconds"] = {{"read", vs.seconds_read}, {"extract", vs.seconds_extract}, {"press", ps.seconds},
+                    {"sharpen", sharp.seconds}, {"total", clock.seconds()}};
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
     write_json(c.stats_json, j);
@@ -102,7 +156,16 @@ void register_press(CLI::App& app, Global& g) {
       ->capture_default_str();
   f->add_option("--flat-bend", c->flats.max_bend, "Degrees: largest normal change across a flat")->capture_default_str();
   f->add_option("--flat-width", c->flats.min_width, "Cells: narrowest flat")->capture_default_str();
-  f->add_flag("--color-regions", c->color_regions, "Colour the vertices by region (flats, curved grey, junctions orange)");
+  f->add_flag("--color-regions", c->color_regions,
+              "Colour the vertices by region (flats, curved grey, junctions orange, sharp curves red)");
+  auto* sh = cmd->add_option_group("sharpen", "Sharp edge recovery (needs flats)");
+  sh->add_flag("--no-sharpen", c->no_sharpen, "Keep the chamfers: do not insert the sharp edges");
+  sh->add_option("--sharp-angle", c->sharpen.sharp_angle, "Degrees between two faces above which their crease is labelled sharp")
+      ->capture_default_str();
+  sh->add_option("--chain-iterations", c->sharpen.chain_iterations, "Bilaplacian iterations along the sharp curves")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
+  sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");

@@ -17,6 +17,7 @@
 #include "voxpress/io/volume_io.h"
 #include "voxpress/smooth/flats.h"
 #include "voxpress/smooth/pressing.h"
+#include "voxpress/smooth/sharpen.h"
 
 namespace voxpress {
 inline constexpr const char* kVersion = "0.1.0";

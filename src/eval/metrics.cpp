@@ -13,6 +13,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -227,7 +228,61 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
   if (vol) r.hausdorff_vox = std::max(r.result_to_truth_vox.max, r.truth_to_result_vox.max);
   const double tv = truth.volume();
   r.volume_ratio = tv > 0 ? signed_volume(result) / tv : 0;
-  r.true_sharp_edges = truth.sharp_edges(o.sharp_angle_deg).size();
+  // (4) Sharp curves, both ways: every point of one set to the nearest
+  // segment of the other, sampled every tenth of a cell.
+  const auto true_sharp = truth.sharp_edges(o.sharp_angle_deg);
+  r.true_sharp_edges = true_sharp.size();
+  r.labelled_sharp_edges = result.edges.size();
+  if (!result.edges.empty() && !true_sharp.empty()) {
+    std::vector<std::array<Vec3, 2>> labelled;
+    labelled.reserve(result.edges.size());
+    for (const auto& e : result.edges) labelled.push_back({result.positions[e[0]], result.positions[e[1]]});
+    // Without a volume, the step is a thousandth of the truth's bounding box diagonal.
+    double step = 0;
+    if (vol) {
+      step = 0.1 / to_index.norm() * std::sqrt(3.0);
+    } else {
+      Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
+      for (const auto& sgm : true_sharp)
+        for (const Vec3& p : sgm) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+      step = (hi - lo).norm() / 1000;
+    }
+    auto directed = [&](const std::vector<std::array<Vec3, 2>>& from, const std::vector<std::array<Vec3, 2>>& to,
+                        double& phys, double& voxels) {
+      std::vector<Vec3> pts;
+      for (const auto& sgm : from) {
+        const int k = std::max(1, int(std::ceil((sgm[1] - sgm[0]).norm() / step)));
+        for (int i = 0; i <= k; ++i) pts.push_back(sgm[0] + (sgm[1] - sgm[0]) * (double(i) / k));
+      }
+      std::vector<double> dp(pts.size()), dv(pts.size());
+      tbb::parallel_for(size_t(0), pts.size(), [&](size_t i) {
+        double best = INFINITY;
+        Vec3 diff = Vec3::Zero();
+        for (const auto& sgm : to) {
+          const Vec3 e = sgm[1] - sgm[0];
+          const double l2 = e.squaredNorm();
+          const double u = l2 > 0 ? std::clamp((pts[i] - sgm[0]).dot(e) / l2, 0.0, 1.0) : 0.0;
+          const Vec3 d = sgm[0] + u * e - pts[i];
+          if (d.squaredNorm() < best) best = d.squaredNorm(), diff = d;
+        }
+        dp[i] = std::sqrt(best);
+        dv[i] = vox(diff);
+      });
+      phys = dp.empty() ? 0 : *std::max_element(dp.begin(), dp.end());
+      voxels = dv.empty() ? 0 : *std::max_element(dv.begin(), dv.end());
+    };
+    double tp = 0, tvx = 0, lp = 0, lv = 0;
+    directed(true_sharp, labelled, tp, tvx);
+    directed(labelled, true_sharp, lp, lv);
+    r.sharp_true_to_labelled = tp;
+    r.sharp_labelled_to_true = lp;
+    r.sharp_edge_hausdorff = std::max(tp, lp);
+    if (vol) {
+      r.sharp_true_to_labelled_vox = tvx;
+      r.sharp_labelled_to_true_vox = lv;
+      r.sharp_edge_hausdorff_vox = std::max(tvx, lv);
+    }
+  }
 
   MeshCheckOptions mo;
   mo.self_intersections = o.self_intersections;

@@ -5,6 +5,8 @@
 // user thresholds are taken in the physical frame.
 #include "voxpress/smooth/flats.h"
 
+#include "surface_graph.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
@@ -90,32 +92,10 @@ int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out) {
 }
 
 // ---------------------------------------------------------------- planes
-// Oriented plane n . x = c (index space), inside at n . x < c.
-struct Plane {
-  Vec3 n{0, 0, 1};
-  double c = 0;
-};
-
-// Principal axes of points: mean, eigenvalues ascending, the smallest's axis.
-struct Pca {
-  Vec3 mean, eigenvalues, normal;
-};
-Pca pca(const std::vector<Vec3>& pts) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : pts) mean += p;
-  mean /= double(pts.size());
-  Mat3 cov = Mat3::Zero();
-  for (const Vec3& p : pts) cov += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
-  return {mean, es.eigenvalues(), es.eigenvectors().col(0)};
-}
-
-// Least-squares plane (orthogonal PCA) of points, oriented along `towards`.
-Plane fit_plane(const std::vector<Vec3>& pts, const Vec3& towards) {
-  const Pca q = pca(pts);
-  const Vec3 n = q.normal.dot(towards) < 0 ? Vec3(-q.normal) : q.normal;
-  return {n, n.dot(q.mean)};
-}
+using detail::fit_plane;
+using detail::Pca;
+using detail::pca;
+using detail::Plane;
 
 // The surface data the detector reads.
 struct Surface {
@@ -459,41 +439,18 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
   });
   S.nrm.assign(n, Vec3::Zero());
   S.area.assign(n, 0);
-  std::vector<uint32_t> deg(n + 1, 0);
   for (const Triangle& tr : s.triangles) {
     const Vec3 c = (S.x[tr[1]] - S.x[tr[0]]).cross(S.x[tr[2]] - S.x[tr[0]]);
     for (uint32_t v : tr) {
       S.nrm[v] += c;
       S.area[v] += c.norm() / 6;
-      deg[v] += 2;
     }
   }
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
     const double l = S.nrm[v].norm();
     S.nrm[v] = l > 0 ? Vec3(S.nrm[v] / l) : Vec3(0, 0, 1);
   });
-  // Adjacency: every triangle edge, once per direction; duplicates removed.
-  S.adj_off.assign(n + 1, 0);
-  for (size_t v = 0; v < n; ++v) S.adj_off[v + 1] = S.adj_off[v] + deg[v];
-  S.adj.resize(S.adj_off[n]);
-  std::vector<uint32_t> fill(S.adj_off.begin(), S.adj_off.end() - 1);
-  for (const Triangle& tr : s.triangles)
-    for (int e = 0; e < 3; ++e) {
-      S.adj[fill[tr[size_t(e)]]++] = tr[size_t((e + 1) % 3)];
-      S.adj[fill[tr[size_t(e)]]++] = tr[size_t((e + 2) % 3)];
-    }
-  // Deduplicate each list in place, then compact.
-  uint32_t out = 0;
-  for (size_t v = 0; v < n; ++v) {
-    const uint32_t b = S.adj_off[v], e = S.adj_off[v + 1];
-    std::sort(S.adj.begin() + b, S.adj.begin() + e);
-    const uint32_t start = out;
-    for (uint32_t k = b; k < e; ++k)
-      if (k == b || S.adj[k] != S.adj[k - 1]) S.adj[out++] = S.adj[k];
-    S.adj_off[v] = start;
-  }
-  S.adj_off[n] = out;
-  S.adj.resize(out);
+  detail::vertex_adjacency(n, s.triangles, S.adj_off, S.adj);
   // Per-vertex normals of the pressed surface still carry a few degrees of
   // staircase noise; averaging over a few rings brings them under one.
   std::vector<Vec3> next(n);
@@ -820,25 +777,22 @@ void add_region_attributes(Mesh& mesh, const FlatSegmentation& f, bool colors) {
   mesh.vertex_attributes.push_back(std::move(junction));
   if (!colors) return;
   mesh.colors.resize(n);
-  for (size_t v = 0; v < n; ++v) {
-    const int32_t r = f.region[v];
-    if (!f.junction.empty() && f.junction[v])
-      mesh.colors[v] = {255, 140, 0, 255};
-    else if (r < 0)
-      mesh.colors[v] = {170, 170, 170, 255};
-    else {
-      // Golden-angle hues: neighbouring ids get distant colours.
-      const double h = std::fmod(double(r) * 137.50776, 360.0) / 60.0;
-      const double x = 1 - std::abs(std::fmod(h, 2.0) - 1);
-      double rgb[3] = {0, 0, 0};
-      const int sector = int(h);
-      const int order[6][2] = {{0, 1}, {1, 0}, {1, 2}, {2, 1}, {2, 0}, {0, 2}};  // HSV sectors: (full, rising)
-      rgb[order[sector][0]] = 1;
-      rgb[order[sector][1]] = x;
-      for (double& c : rgb) c = 0.25 + 0.65 * c;
-      mesh.colors[v] = {uint8_t(255 * rgb[0]), uint8_t(255 * rgb[1]), uint8_t(255 * rgb[2]), 255};
-    }
-  }
+  for (size_t v = 0; v < n; ++v) mesh.colors[v] = region_color(f.region[v], !f.junction.empty() && f.junction[v]);
+}
+
+std::array<uint8_t, 4> region_color(int32_t region, bool junction) {
+  if (junction) return {255, 140, 0, 255};
+  if (region < 0) return {170, 170, 170, 255};
+  // Golden-angle hues: neighbouring ids get distant colours.
+  const double h = std::fmod(double(region) * 137.50776, 360.0) / 60.0;
+  const double x = 1 - std::abs(std::fmod(h, 2.0) - 1);
+  double rgb[3] = {0, 0, 0};
+  const int sector = int(h);
+  const int order[6][2] = {{0, 1}, {1, 0}, {1, 2}, {2, 1}, {2, 0}, {0, 2}};  // HSV sectors: (full, rising)
+  rgb[order[sector][0]] = 1;
+  rgb[order[sector][1]] = x;
+  for (double& c : rgb) c = 0.25 + 0.65 * c;
+  return {uint8_t(255 * rgb[0]), uint8_t(255 * rgb[1]), uint8_t(255 * rgb[2]), 255};
 }
 
 }  // namespace voxpress

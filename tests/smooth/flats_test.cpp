@@ -271,16 +271,9 @@ TEST(Flats, RegionAttributesAndColours) {
 
 TEST(Flats, FandiskStagesBeatTheMidpoint) {
   VOXPRESS_REQUIRE_SHARED_DATA();
-  const Mesh model = read_mesh(test::shared_data() + "/meshes/fandisk.off");
-  VoxelizeOptions vo;
-  vo.res = 128;
-  vo.rotation = parse_rotation("random:1");
-  const Voxelized v = voxelize(model, vo);
-  Mesh phys = model;
-  for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
-  const auto truth = mesh_truth(std::move(phys), "fandisk");
+  const test::VoxelizedModel v = test::voxelized_shared_model("fandisk.off", 128, 1);
   StickSurface s = extract_sticks(v.volume);
-  const Stages st = stages(s, v.volume, *truth);
+  const Stages st = stages(s, v.volume, *v.truth);
   const FlatSegmentation& seg = st.seg;
   const double e_tiles = st.tiles;
   const EvalReport& final_report = st.final_report;

@@ -14,8 +14,9 @@
 //     the normal of the incident true face best aligned with the result's);
 //   * volume ratio result / truth; classification violations against the
 //     volume; the check_mesh verdict;
-//   * two-sided Hausdorff between the true sharp edges and the result's
-//     labelled sharp edges (n/a until results carry sharp-edge labels).
+//   * two-sided Hausdorff between the true sharp edges (dihedral angle above
+//     sharp_angle_deg) and the result's labelled sharp edges (Mesh::edges),
+//     both sampled every 0.1 cell.
 // Sampling is deterministic (seeded, counter-based) and parallel; the
 // numbers do not depend on the thread count.
 #pragma once
@@ -60,7 +61,12 @@ struct EvalReport {
   std::optional<uint64_t> classification_violations;
   MeshCheck mesh;
   size_t true_sharp_edges = 0;             ///< segments of the truth's sharp curves
-  std::optional<double> sharp_edge_hausdorff;  ///< n/a until results carry sharp-edge labels
+  size_t labelled_sharp_edges = 0;         ///< the result's labelled sharp edges (Mesh::edges)
+  /// Largest distance from a true sharp curve to the labelled ones, the
+  /// reverse, and their maximum (two-sided Hausdorff); n/a when either set is
+  /// empty. Physical units, and in voxels when the volume is known.
+  std::optional<double> sharp_true_to_labelled, sharp_labelled_to_true, sharp_edge_hausdorff;
+  std::optional<double> sharp_true_to_labelled_vox, sharp_labelled_to_true_vox, sharp_edge_hausdorff_vox;
   std::string truth;
 };
 

@@ -46,6 +46,7 @@
 // docs/ARCHITECTURE.md).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -122,5 +123,9 @@ FeaturePressStats press_with_flats(StickSurface& surface, const SliceCurves& cur
 /// "region" (int32: flat id, -1 curved) and "junction" (uint8) attributes,
 /// and, when `colors`, a colour per region (curved grey, junctions orange).
 void add_region_attributes(Mesh& mesh, const FlatSegmentation& flats, bool colors);
+
+/// The preview colour of a region: a distinct hue per flat id, grey for
+/// curved (-1), orange for junctions.
+std::array<uint8_t, 4> region_color(int32_t region, bool junction);
 
 }  // namespace voxpress

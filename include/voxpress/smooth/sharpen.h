@@ -1,0 +1,77 @@
+// voxpress/smooth/sharpen.h — sharp edge recovery (Pressing, Chica et al.,
+// Section 5) and the flat / curved / sharp segmentation as output.
+//
+// The pressed stick surface cuts every feature with a chamfer one cell wide:
+// its vertices sample the lattice edges, never the crease itself. Sharpening
+// inserts the crease (Section 5, Fig. 8-10):
+//
+//  1. Chamfer edges join vertices of two different regions (two flats, or a
+//     flat and a curved junction vertex); smooth flat/curved borders (no
+//     junction) and flats meeting at less than `min_angle` are left alone.
+//     Each chamfer edge gets a new vertex; a triangle with one chamfer edge
+//     becomes 2 triangles, with two 3, with three 6 around a new corner vertex.
+//  2. Each side of a chamfer edge has a plane: a flat's own plane, or for a
+//     curved junction vertex the least-squares plane of the fresh,
+//     non-junction vertices in its 2-ring. A new edge vertex moves to the
+//     closest point of the two planes' intersection line, a corner vertex to
+//     the three planes' intersection; both solved as a truncated
+//     least-squares problem (directions the planes do not pin stay where the
+//     vertex is), and left in place when the planes meet at less than
+//     `min_angle` or the solution lies more than `max_move` cells away.
+//  3. The new vertices form chains along the new edges (corners and ends
+//     fixed); the chains are smoothed with a bilaplacian, each vertex moving
+//     across its chain only and, next to a flat, within the flat's plane.
+//  4. Beyond the paper — the guarantee survives: every move is checked
+//     exactly before it is made. A vertex moving from p to q sweeps each
+//     incident triangle (p, a, b) through the tetrahedron (p, q, a, b); a
+//     move is cut back (bisection) until no lattice sample lies in any swept
+//     tetrahedron, no incident triangle turns over and none meets another
+//     triangle nearby. So no sample ever changes side, and the mesh stays
+//     closed, 2-manifold and free of self-intersections.
+//
+// Output: the refined mesh (physical units) with a face attribute "region"
+// (flat id, or -1: curved, including the faces straddling a smooth border),
+// vertex attributes "region", "junction" and "feature" (1 on a sharp curve),
+// and mesh.edges = the edges of the sharp feature curves (the creases whose
+// two sides meet at `sharp_angle` or more).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/progress.h"
+#include "voxpress/extract/sticks.h"
+#include "voxpress/smooth/flats.h"
+
+namespace voxpress {
+
+struct SharpenOptions {
+  double sharp_angle = 30;    ///< degrees between the two sides' normals above which a crease is labelled sharp
+  double min_angle = 10;      ///< degrees: planes meeting at less are not intersected
+  double max_move = 2;        ///< cells: farthest a new vertex may move from where it was inserted
+  int chain_iterations = 10;  ///< bilaplacian iterations along the feature chains (0: none)
+  int min_curved = 25;        ///< vertices: smaller curved patches are chamfer leftovers and join a flat
+  bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
+  Progress* progress = nullptr;
+};
+
+struct SharpenStats {
+  size_t chamfer_edges = 0, chamfer_triangles = 0;
+  size_t inserted = 0, corners = 0;   ///< new edge vertices, new corner vertices
+  size_t fallbacks = 0;               ///< new vertices left where inserted (parallel planes, far solution, no plane)
+  size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
+  size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
+  double seconds = 0;
+};
+
+struct SharpenResult {
+  Mesh mesh;
+  SharpenStats stats;
+};
+
+/// Sharpens the pressed `surface` segmented by `flats` (from press_with_flats).
+/// Without flats the result is to_mesh(surface) with the attributes.
+SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options = {});
+
+}  // namespace voxpress

@@ -1,0 +1,616 @@
+// Sharp edge recovery (Chica et al., Section 5). Theory of operation:
+// include/voxpress/smooth/sharpen.h. Geometry is done in index space, where
+// the lattice samples are the integer points; angles compared with user
+// thresholds are taken in the physical frame.
+#include "voxpress/smooth/sharpen.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "core/predicates.h"
+#include "surface_graph.h"
+
+namespace voxpress {
+namespace {
+
+using detail::Plane;
+constexpr uint32_t kNone = UINT32_MAX;
+constexpr double kPi = std::numbers::pi;
+constexpr int kBucket = 4;       // cells per side of the buckets of the local intersection test
+constexpr int kBisections = 8;   // steps when a move is cut back
+constexpr int kRounds = 8;       // passes over the new vertices' moves
+
+uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
+
+// Is z in the closed tetrahedron (a, b, c, d)? A flat tetrahedron counts z
+// when z is coplanar with it (conservative).
+bool in_closed_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z) {
+  const int o = detail::orient3d(a, b, c, d);
+  if (o == 0) return detail::orient3d(a, c, d, z) == 0 || detail::orient3d(b, c, d, z) == 0;
+  return detail::orient3d(z, b, c, d) * o >= 0 && detail::orient3d(a, z, c, d) * o >= 0 &&
+         detail::orient3d(a, b, z, d) * o >= 0 && detail::orient3d(a, b, c, z) * o >= 0;
+}
+
+// The point nearest x0 that best satisfies the planes in the least-squares
+// sense: x0 + pinv(A) (b - A x0) with A = sum n n^T, b = sum n c, and
+// eigenvalues below `floor` truncated (those directions keep x0) — the
+// dual-contouring QEF solve. For two planes it is the closest point of their
+// intersection line to x0; for three, their common point.
+Vec3 solve_planes(const Plane* planes, int count, const Vec3& x0, double floor) {
+  Mat3 A = Mat3::Zero();
+  Vec3 r = Vec3::Zero();
+  for (int i = 0; i < count; ++i) {
+    A += planes[i].n * planes[i].n.transpose();
+    r += planes[i].n * (planes[i].c - planes[i].n.dot(x0));
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> es(A);
+  Vec3 dx = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const double l = es.eigenvalues()[k];
+    if (l < floor) continue;
+    const Vec3 e = es.eigenvectors().col(k);
+    dx += e * (e.dot(r) / l);
+  }
+  return x0 + dx;
+}
+
+struct NewVertex {
+  uint32_t a = kNone, b = kNone;  // edge vertex: the chamfer edge's ends; corner: kNone
+  uint32_t tri = kNone;           // corner: its original triangle
+  Vec3 target = Vec3::Zero();
+  Vec3 along = Vec3::Zero();      // edge vertex between two planes: their intersection line's direction
+  bool moves = false;             // has a target away from where it was inserted
+  bool sharp = false;             // on a labelled sharp crease
+};
+
+struct Sharpener {
+  const StickSurface& s;
+  const FlatSegmentation& seg;
+  const SharpenOptions& o;
+  size_t n = 0;
+  Mat3 Minv_t;
+  std::vector<uint32_t> adj_off, adj;       // original vertex adjacency
+  std::vector<Vec3> x;                      // positions (index space): original, then new
+  std::vector<Triangle> tris;               // the refined triangles
+  std::vector<uint32_t> parent;             // original triangle of each refined triangle
+  std::vector<NewVertex> nv;                // new vertex n + k
+  std::vector<std::array<uint32_t, 2>> feature_edges;  // new edges between new vertices
+  std::vector<int32_t> label;               // per original vertex: flat id or -1 (seg.region + leftovers)
+  std::vector<uint32_t> leftovers;          // curved junction vertices that joined a flat
+  std::vector<int8_t> plane_state;          // per original vertex: 0 unknown, 1 has plane, -1 none
+  std::vector<Plane> plane;
+  std::vector<uint32_t> fan_off, fan;       // triangles around each vertex (CSR)
+  std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;  // refined triangles by parent cell bucket
+  std::vector<std::array<int64_t, 3>> tri_cell;                 // per original triangle
+  SharpenStats st;
+
+  Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
+      : s(surface), seg(f), o(opts), n(surface.stick_count()) {
+    Minv_t = s.lattice.index_to_physical_matrix().inverse().transpose();
+  }
+
+  Vec3 physical_normal(const Vec3& index_normal) const { return (Minv_t * index_normal).normalized(); }
+  double angle_deg(const Vec3& na, const Vec3& nb) const {
+    return std::acos(std::clamp(physical_normal(na).dot(physical_normal(nb)), -1.0, 1.0)) * 180 / kPi;
+  }
+
+  // The plane of an original vertex's side (Section 5): its flat's plane, or
+  // for a curved vertex the least-squares plane of the fresh, non-junction
+  // vertices in its 2-ring (all fresh ones when fewer than 3), oriented
+  // outwards (along the sticks' inside -> outside directions).
+  const Plane* plane_of(uint32_t v) {
+    if (plane_state[v] != 0) return plane_state[v] > 0 ? &plane[v] : nullptr;
+    plane_state[v] = -1;
+    const int32_t r = label[v];
+    if (r >= 0) {
+      const Flat& f = seg.flats[size_t(r)];
+      plane[v] = {f.index_normal, f.index_offset};
+      plane_state[v] = 1;
+      return &plane[v];
+    }
+    std::vector<uint32_t> ring{v};
+    for (int k = 0; k < 2; ++k) {
+      const size_t end = ring.size();
+      for (size_t i = 0; i < end; ++i)
+        for (uint32_t q = adj_off[ring[i]]; q < adj_off[ring[i] + 1]; ++q) ring.push_back(adj[q]);
+      std::sort(ring.begin(), ring.end());
+      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    }
+    std::vector<Vec3> pts;
+    Vec3 towards = Vec3::Zero();
+    for (int pass = 0; pass < 2 && pts.size() < 3; ++pass) {
+      pts.clear();
+      towards.setZero();
+      for (uint32_t q : ring)
+        if (label[q] < 0 && (pass == 1 || !seg.junction[q])) {
+          pts.push_back(x[q]);
+          towards[s.axis(q)] += s.lower_inside(q) ? 1 : -1;
+        }
+    }
+    if (pts.size() < 3) return nullptr;
+    const detail::Pca p = detail::pca(pts);
+    if (!(p.eigenvalues[1] > 1e-6)) return nullptr;  // collinear points
+    plane[v] = detail::fit_plane(pts, towards);
+    plane_state[v] = 1;
+    return &plane[v];
+  }
+
+  // Section 5: an edge whose ends lie on two different faces (two flats, or
+  // a flat and a curved junction vertex).
+  bool chamfer(uint32_t u, uint32_t v) const {
+    const int32_t a = label[u], b = label[v];
+    if (a == b) return false;
+    if (a >= 0 && b >= 0) {
+      const Vec3& na = seg.flats[size_t(a)].normal;
+      const Vec3& nb = seg.flats[size_t(b)].normal;
+      return std::acos(std::clamp(na.dot(nb), -1.0, 1.0)) * 180 / kPi >= o.min_angle;
+    }
+    return seg.junction[a < 0 ? u : v] != 0;
+  }
+
+  // Beyond the paper: curved vertices that are not part of a curved face
+  // join a flat. They are the vertices of small curved patches (fewer than
+  // `min_curved`: slivers of chamfer the flats' planes did not stab near
+  // edges and corners, or holes inside a flat) and curved junction vertices
+  // with no curved surface around them (fewer than 3 fresh vertices in their
+  // 2-ring, so no plane of their own). Each joins the flat within 3 rings
+  // whose plane is nearest and is later projected onto it (a checked move),
+  // so creases lie between flats and real curved faces only.
+  void join_leftovers() {
+    std::vector<uint8_t> small(n, 0);
+    std::vector<uint32_t> comp, stack;
+    std::vector<uint8_t> seen(n, 0);
+    for (uint32_t v0 = 0; v0 < n; ++v0) {
+      if (label[v0] >= 0 || seen[v0]) continue;
+      comp.clear();
+      stack.assign(1, v0);
+      seen[v0] = 1;
+      while (!stack.empty()) {
+        const uint32_t v = stack.back();
+        stack.pop_back();
+        comp.push_back(v);
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+          if (label[adj[k]] < 0 && !seen[adj[k]]) seen[adj[k]] = 1, stack.push_back(adj[k]);
+      }
+      if (comp.size() < size_t(o.min_curved))
+        for (uint32_t v : comp) small[v] = 1;
+    }
+    std::vector<std::pair<uint32_t, int32_t>> joins;
+    std::vector<uint32_t> ring;
+    for (uint32_t v = 0; v < n; ++v) {
+      if (label[v] >= 0 || !(small[v] || (seg.junction[v] && !plane_of(v)))) continue;
+      int32_t best = -1;
+      double best_d = INFINITY;
+      ring.assign(1, v);
+      for (int r = 0; r < 3 && best < 0; ++r) {
+        const size_t end = ring.size();
+        for (size_t i = 0; i < end; ++i)
+          for (uint32_t k = adj_off[ring[i]]; k < adj_off[ring[i] + 1]; ++k) ring.push_back(adj[k]);
+        std::sort(ring.begin(), ring.end());
+        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+        for (uint32_t q : ring) {
+          const int32_t f = label[q];
+          if (f < 0) continue;
+          const Flat& fl = seg.flats[size_t(f)];
+          const double d = std::abs(fl.index_normal.dot(x[v]) - fl.index_offset);
+          if (d < best_d) best_d = d, best = f;
+        }
+      }
+      if (best >= 0) joins.push_back({v, best});
+    }
+    for (const auto& [v, f] : joins) {
+      label[v] = f;
+      plane_state[v] = 0;
+      leftovers.push_back(v);
+    }
+  }
+
+  uint32_t add_vertex(const NewVertex& v, const Vec3& at) {
+    nv.push_back(v);
+    x.push_back(at);
+    return uint32_t(n + nv.size() - 1);
+  }
+
+  // Figure 8: split the chamfer triangles; new vertices start on their
+  // edges (the surface is unchanged until they move).
+  void subdivide() {
+    std::unordered_map<uint64_t, uint32_t> on_edge;
+    const double floor2 = 1 - std::cos(o.min_angle * kPi / 180);
+    auto edge_vertex = [&](uint32_t a, uint32_t b) {
+      auto [it, fresh] = on_edge.try_emplace(edge_key(a, b), kNone);
+      if (!fresh) return it->second;
+      ++st.chamfer_edges;
+      NewVertex v;
+      v.a = std::min(a, b);
+      v.b = std::max(a, b);
+      const Vec3 xa = x[v.a], xb = x[v.b];
+      const Plane* pa = plane_of(v.a);
+      const Plane* pb = plane_of(v.b);
+      double u = 0.5;
+      Vec3 start = xa + u * (xb - xa);
+      if (pa && pb) {
+        const Plane pl[2] = {*pa, *pb};
+        // Start where the edge comes closest to both planes (least squares in u).
+        double num = 0, den = 0;
+        for (const Plane& p : pl) {
+          const double g = p.n.dot(xb - xa), h = p.c - p.n.dot(xa);
+          num += g * h;
+          den += g * g;
+        }
+        if (den > 1e-12) u = std::clamp(num / den, 0.1, 0.9);
+        start = xa + u * (xb - xa);
+        const double angle = angle_deg(pa->n, pb->n);
+        v.sharp = angle >= o.sharp_angle;
+        if (1 - pa->n.dot(pb->n) >= floor2) {
+          v.target = solve_planes(pl, 2, start, floor2);
+          v.moves = (v.target - start).norm() <= o.max_move;
+          v.along = pa->n.cross(pb->n).normalized();
+        }
+      }
+      if (!v.moves) {
+        v.target = start;
+        ++st.fallbacks;
+      }
+      return it->second = add_vertex(v, start);
+    };
+    for (size_t f = 0; f < s.triangles.size(); ++f) {
+      const Triangle& t = s.triangles[f];
+      uint32_t m[3];
+      int k = 0;
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = t[size_t(e)], b = t[size_t((e + 1) % 3)];
+        m[e] = chamfer(a, b) ? edge_vertex(a, b) : kNone;
+        k += m[e] != kNone;
+      }
+      auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+        tris.push_back({a, b, c});
+        parent.push_back(uint32_t(f));
+      };
+      if (k == 0) {
+        emit(t[0], t[1], t[2]);
+        continue;
+      }
+      ++st.chamfer_triangles;
+      if (k == 1) {  // Fig. 8a: two triangles
+        const int e = m[0] != kNone ? 0 : m[1] != kNone ? 1 : 2;
+        const uint32_t pa = t[size_t(e)], pb = t[size_t((e + 1) % 3)], pc = t[size_t((e + 2) % 3)];
+        emit(pa, m[e], pc);
+        emit(m[e], pb, pc);
+      } else if (k == 2) {  // Fig. 8b: three triangles; the apex is where the two chamfer edges meet
+        const int free_edge = m[0] == kNone ? 0 : m[1] == kNone ? 1 : 2;
+        const int apex = (free_edge + 2) % 3;
+        const uint32_t p0 = t[size_t(apex)], p1 = t[size_t((apex + 1) % 3)], p2 = t[size_t((apex + 2) % 3)];
+        const uint32_t m01 = m[apex], m20 = m[(apex + 2) % 3];
+        emit(p0, m01, m20);
+        if ((x[m01] - x[p2]).squaredNorm() <= (x[p1] - x[m20]).squaredNorm()) {
+          emit(m01, p1, p2);
+          emit(m01, p2, m20);
+        } else {
+          emit(m01, p1, m20);
+          emit(p1, p2, m20);
+        }
+        feature_edges.push_back({m01, m20});
+      } else {  // Fig. 8c: six triangles around a corner vertex
+        NewVertex c;
+        c.tri = uint32_t(f);
+        const Vec3 start = (x[m[0]] + x[m[1]] + x[m[2]]) / 3;
+        const Plane* p[3] = {plane_of(t[0]), plane_of(t[1]), plane_of(t[2])};
+        c.target = start;
+        if (p[0] && p[1] && p[2]) {
+          const Plane pl[3] = {*p[0], *p[1], *p[2]};
+          c.target = solve_planes(pl, 3, start, floor2);
+          c.moves = (c.target - start).norm() <= o.max_move;
+          if (!c.moves) c.target = start;
+        }
+        if (!c.moves) ++st.fallbacks;
+        c.sharp = true;
+        const uint32_t w = add_vertex(c, start);
+        ++st.corners;
+        for (int e = 0; e < 3; ++e) {
+          emit(t[size_t(e)], m[e], w);
+          emit(m[e], t[size_t((e + 1) % 3)], w);
+          feature_edges.push_back({w, m[e]});
+        }
+      }
+    }
+    st.inserted = nv.size() - st.corners;
+  }
+
+  std::array<int64_t, 3> bucket_of(const Vec3& p) const {
+    return {int64_t(std::floor(p.x() / kBucket)), int64_t(std::floor(p.y() / kBucket)), int64_t(std::floor(p.z() / kBucket))};
+  }
+  static uint64_t bucket_key(const std::array<int64_t, 3>& b) {
+    return (uint64_t(b[0] + (1 << 20)) << 42) | (uint64_t(b[1] + (1 << 20)) << 21) | uint64_t(b[2] + (1 << 20));
+  }
+
+  // Triangles around every vertex, and the buckets of
+  // refined triangles near the chamfers (for the local intersection test).
+  void index() {
+    const size_t nvert = x.size();
+    fan_off.assign(nvert + 1, 0);
+    for (const Triangle& t : tris)
+      for (uint32_t v : t) ++fan_off[v + 1];
+    for (size_t v = 0; v < nvert; ++v) fan_off[v + 1] += fan_off[v];
+    fan.resize(fan_off[nvert]);
+    std::vector<uint32_t> fill(fan_off.begin(), fan_off.end() - 1);
+    for (uint32_t f = 0; f < tris.size(); ++f)
+      for (uint32_t v : tris[f]) fan[fill[v]++] = f;
+    std::unordered_map<uint64_t, uint8_t> near;
+    for (size_t f = 0; f < tris.size(); ++f) {
+      bool touches_new = false;
+      for (uint32_t v : tris[f]) touches_new |= v >= n;
+      if (!touches_new) continue;
+      const auto b = bucket_of(x[tris[f][0]]);
+      for (int64_t dz = -1; dz <= 1; ++dz)
+        for (int64_t dy = -1; dy <= 1; ++dy)
+          for (int64_t dx = -1; dx <= 1; ++dx) near[bucket_key({b[0] + dx, b[1] + dy, b[2] + dz})] = 1;
+    }
+    for (uint32_t f = 0; f < tris.size(); ++f) {
+      const uint64_t k = bucket_key(bucket_of(x[tris[f][0]]));
+      if (near.count(k)) buckets[k].push_back(f);
+    }
+  }
+
+  // May vertex v move from x[v] to q? (Section 5 beyond the paper: the
+  // guarantee and a valid mesh.)
+  bool allowed(uint32_t v, const Vec3& q) const {
+    const Vec3 p = x[v];
+    auto at = [&](uint32_t w) -> const Vec3& { return w == v ? q : x[w]; };
+    Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+    for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k) {
+      const Triangle& t = tris[fan[k]];
+      const int i = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      const Vec3& a = x[t[size_t((i + 1) % 3)]];
+      const Vec3& b = x[t[size_t((i + 2) % 3)]];
+      const Vec3 nn = (a - q).cross(b - q);
+      if (!(nn.squaredNorm() > 1e-20) || nn.dot((a - p).cross(b - p)) <= 0) return false;  // turned over
+      if (detail::triangle_degenerate(q, a, b)) return false;
+      lo = lo.cwiseMin(a).cwiseMin(b);
+      hi = hi.cwiseMax(a).cwiseMax(b);
+      // No lattice sample in the swept tetrahedron (p, q, a, b).
+      const Vec3 tl = p.cwiseMin(q).cwiseMin(a).cwiseMin(b), th = p.cwiseMax(q).cwiseMax(a).cwiseMax(b);
+      for (double zz = std::ceil(tl.z()); zz <= th.z(); ++zz)
+        for (double yy = std::ceil(tl.y()); yy <= th.y(); ++yy)
+          for (double xx = std::ceil(tl.x()); xx <= th.x(); ++xx)
+            if (in_closed_tet(p, q, a, b, Vec3(xx, yy, zz))) return false;
+    }
+    // The fan does not fold onto itself, and no refined triangle nearby meets it.
+    for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k)
+      for (uint32_t k2 = k + 1; k2 < fan_off[v + 1]; ++k2) {
+        const Triangle& t = tris[fan[k]];
+        const Triangle& u = tris[fan[k2]];
+        const Vec3 fb[3] = {at(t[0]), at(t[1]), at(t[2])};
+        const Vec3 ub[3] = {at(u[0]), at(u[1]), at(u[2])};
+        const uint32_t fi[3] = {t[0], t[1], t[2]}, ui[3] = {u[0], u[1], u[2]};
+        if (detail::triangles_intersect(fb, fi, ub, ui)) return false;
+      }
+    const auto b0 = bucket_of(lo - Vec3::Constant(kBucket)), b1 = bucket_of(hi + Vec3::Constant(kBucket));
+    for (int64_t bz = b0[2]; bz <= b1[2]; ++bz)
+      for (int64_t by = b0[1]; by <= b1[1]; ++by)
+        for (int64_t bx = b0[0]; bx <= b1[0]; ++bx) {
+          const auto it = buckets.find(bucket_key({bx, by, bz}));
+          if (it == buckets.end()) continue;
+          for (uint32_t g : it->second) {
+            const Triangle& tg = tris[g];
+            if (tg[0] == v || tg[1] == v || tg[2] == v) continue;
+            const Vec3 gb[3] = {x[tg[0]], x[tg[1]], x[tg[2]]};
+            const Vec3 glo = gb[0].cwiseMin(gb[1]).cwiseMin(gb[2]), ghi = gb[0].cwiseMax(gb[1]).cwiseMax(gb[2]);
+            if ((glo.array() > hi.array()).any() || (ghi.array() < lo.array()).any()) continue;
+            if (detail::triangle_degenerate(gb[0], gb[1], gb[2])) continue;
+            const uint32_t gi[3] = {tg[0], tg[1], tg[2]};
+            for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k) {
+              const Triangle& t = tris[fan[k]];
+              const Vec3 fb[3] = {at(t[0]), at(t[1]), at(t[2])};
+              const uint32_t fi[3] = {t[0], t[1], t[2]};
+              if (detail::triangles_intersect(fb, fi, gb, gi)) return false;
+            }
+          }
+        }
+    return true;
+  }
+
+  // Moves v to q if allowed; otherwise, when `partial`, as far towards q as
+  // allowed (bisection on the fraction: the allowed fractions form an
+  // interval from 0, as the swept tetrahedra nest). Returns true at q.
+  bool move(uint32_t v, const Vec3& q, bool partial = true) {
+    const Vec3 p = x[v];
+    if (q == p) return true;
+    if (allowed(v, q)) {
+      x[v] = q;
+      return true;
+    }
+    if (!partial) return false;
+    ++st.cut_back;
+    double lo = 0, hi = 1;
+    for (int i = 0; i < kBisections; ++i) {
+      const double mid = (lo + hi) / 2;
+      (allowed(v, p + mid * (q - p)) ? lo : hi) = mid;
+    }
+    if (lo > 0) x[v] = p + lo * (q - p);
+    return false;
+  }
+
+  // The chains: each new vertex's neighbours along the new edges.
+  std::vector<std::array<uint32_t, 2>> chain_nb;
+  std::vector<uint8_t> chain_degree;
+  void build_chains() {
+    const size_t m = nv.size();
+    chain_nb.assign(m, {kNone, kNone});
+    chain_degree.assign(m, 0);
+    for (const auto& e : feature_edges)
+      for (int k = 0; k < 2; ++k) {
+        const uint32_t a = e[size_t(k)] - uint32_t(n), b = e[size_t(1 - k)];
+        if (chain_degree[a] < 2) chain_nb[a][chain_degree[a]] = b;
+        ++chain_degree[a];
+      }
+  }
+  bool inner(uint32_t i) const { return chain_degree[i] == 2 && nv[i].tri == kNone; }
+
+  // Beyond the paper: targets on an intersection line are the projections
+  // of where the vertices were inserted, which bunch up (or even swap) where
+  // the staircase runs across the crease, folding the triangles between
+  // them. Before moving, inner chain vertices slide along their line towards
+  // the mean of their neighbours' targets (Jacobi, a few rounds), which
+  // evens out their spacing without leaving the line.
+  void spread_targets() {
+    std::vector<Vec3> next(nv.size());
+    for (int it = 0; it < 10; ++it) {
+      for (uint32_t i = 0; i < nv.size(); ++i) {
+        next[i] = nv[i].target;
+        if (!inner(i) || !nv[i].moves || nv[i].along.isZero()) continue;
+        const uint32_t a = chain_nb[i][0] - uint32_t(n), b = chain_nb[i][1] - uint32_t(n);
+        const Vec3 d = (nv[a].target + nv[b].target) / 2 - nv[i].target;
+        next[i] += 0.5 * d.dot(nv[i].along) * nv[i].along;
+      }
+      for (uint32_t i = 0; i < nv.size(); ++i) nv[i].target = next[i];
+    }
+  }
+
+  // Section 5, last paragraph: the new vertices form chains along the new
+  // edges; chain vertices (not ends, not corners) are smoothed with a
+  // bilaplacian, moving across the chain only and within a flat's plane.
+  void smooth_chains() {
+    const size_t m = nv.size();
+    std::vector<Vec3> L(m), step(m);
+    for (int it = 0; it < o.chain_iterations; ++it) {
+      for (uint32_t i = 0; i < m; ++i)
+        L[i] = inner(i) ? Vec3((x[chain_nb[i][0]] + x[chain_nb[i][1]]) / 2 - x[n + i]) : Vec3::Zero();
+      for (uint32_t i = 0; i < m; ++i) {
+        step[i].setZero();
+        if (!inner(i)) continue;
+        const NewVertex& v = nv[i];
+        const int32_t ra = label[v.a], rb = label[v.b];
+        if (ra >= 0 && rb >= 0) continue;  // on the exact line of two flats
+        // -L^2 = L(v) - mean of the neighbours' L; 1/4 damps a zigzag in one step.
+        Vec3 d = 0.25 * (L[i] - (L[chain_nb[i][0] - n] + L[chain_nb[i][1] - n]) / 2);
+        const Vec3 tangent = (x[chain_nb[i][1]] - x[chain_nb[i][0]]).normalized();
+        d -= d.dot(tangent) * tangent;
+        if (ra >= 0 || rb >= 0) {
+          const Vec3& fn = seg.flats[size_t(ra >= 0 ? ra : rb)].index_normal;
+          d -= d.dot(fn) * fn;
+        }
+        step[i] = d;
+      }
+      for (uint32_t i = 0; i < m; ++i)
+        if (step[i].squaredNorm() > 0) move(uint32_t(n + i), x[n + i] + step[i]);
+    }
+  }
+
+  SharpenResult run() {
+    const auto t0 = std::chrono::steady_clock::now();
+    detail::vertex_adjacency(n, s.triangles, adj_off, adj);
+    x.resize(n);
+    for (size_t v = 0; v < n; ++v) x[v] = s.index_position(v);
+    plane_state.assign(n, 0);
+    plane.resize(n);
+    label = seg.region;
+    if (!seg.flats.empty()) {
+      join_leftovers();
+      subdivide();
+    } else {
+      tris = s.triangles;
+      parent.resize(tris.size());
+      for (size_t f = 0; f < tris.size(); ++f) parent[f] = uint32_t(f);
+    }
+    if (!nv.empty()) {
+      index();
+      build_chains();
+      spread_targets();
+      // The moves, in order: leftovers onto their flat, edge vertices onto
+      // their crease, then corners (Section 5). A move blocked by a
+      // neighbour that has not moved yet is retried in the next round; the
+      // last round cuts the remaining moves back to what is allowed.
+      std::vector<std::pair<uint32_t, Vec3>> jobs;
+      for (uint32_t v : leftovers) {
+        const Flat& f = seg.flats[size_t(label[v])];
+        jobs.push_back({v, x[v] - (f.index_normal.dot(x[v]) - f.index_offset) * f.index_normal});
+      }
+      for (int corners = 0; corners < 2; ++corners)
+        for (size_t i = 0; i < nv.size(); ++i)
+          if (nv[i].moves && (nv[i].tri != kNone) == bool(corners)) jobs.push_back({uint32_t(n + i), nv[i].target});
+      std::vector<uint8_t> done(jobs.size(), 0);
+      // Neighbours that block each other (two vertices of one thin triangle)
+      // get there together: a blocked vertex goes half way instead.
+      for (int round = 0; round < kRounds; ++round)
+        for (size_t j = 0; j < jobs.size(); ++j) {
+          if (done[j]) continue;
+          const uint32_t v = jobs[j].first;
+          done[j] = move(v, jobs[j].second, round + 1 == kRounds);
+          if (!done[j] && round + 1 < kRounds) move(v, (x[v] + jobs[j].second) / 2, false);
+        }
+      smooth_chains();
+    }
+    SharpenResult r;
+    r.mesh = output();
+    st.sharp_edges = r.mesh.edges.size();
+    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.stats = st;
+    return r;
+  }
+
+  Mesh output() const {
+    Mesh m;
+    const Mat3 M = s.lattice.index_to_physical_matrix();
+    m.positions.resize(x.size());
+    for (size_t v = 0; v < x.size(); ++v) m.positions[v] = s.lattice.origin + M * x[v];
+    m.triangles = tris;
+    if (s.lattice.flips_orientation())
+      for (Triangle& t : m.triangles) std::swap(t[1], t[2]);
+    MeshAttribute region{"region", ScalarType::i32, std::vector<double>(x.size(), -1)};
+    MeshAttribute junction{"junction", ScalarType::u8, std::vector<double>(x.size(), 0)};
+    MeshAttribute feature{"feature", ScalarType::u8, std::vector<double>(x.size(), 0)};
+    for (size_t v = 0; v < n; ++v) {
+      region.values[v] = label[v];
+      junction.values[v] = seg.junction.empty() ? 0 : seg.junction[v];
+    }
+    // Sharp feature edges: new edges whose edge vertex lies on a sharp crease.
+    for (const auto& e : feature_edges) {
+      const NewVertex& a = nv[e[0] - n];
+      const NewVertex& b = nv[e[1] - n];
+      const bool sharp = (a.tri != kNone || a.sharp) && (b.tri != kNone || b.sharp);
+      if (!sharp) continue;
+      m.edges.push_back(e);
+      feature.values[e[0]] = feature.values[e[1]] = 1;
+    }
+    // A face belongs to flat f when all its original vertices do (so flats'
+    // faces are planar); otherwise it is curved.
+    MeshAttribute face_region{"region", ScalarType::i32, std::vector<double>(tris.size(), -1)};
+    for (size_t f = 0; f < tris.size(); ++f) {
+      int32_t r = -2;
+      for (uint32_t v : tris[f]) {
+        if (v >= n) continue;
+        const int32_t rv = label[v];
+        r = r == -2 || r == rv ? rv : -1;
+      }
+      face_region.values[f] = r < 0 ? -1 : r;
+    }
+    if (o.colors) {
+      m.colors.resize(x.size());
+      for (size_t v = 0; v < x.size(); ++v)
+        m.colors[v] = feature.values[v] ? std::array<uint8_t, 4>{200, 20, 20, 255}
+                                        : region_color(int32_t(region.values[v]), junction.values[v] != 0);
+    }
+    m.vertex_attributes = {std::move(region), std::move(junction), std::move(feature)};
+    m.face_attributes = {std::move(face_region)};
+    return m;
+  }
+};
+
+}  // namespace
+
+SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options) {
+  if (!flats.region.empty() && flats.region.size() != surface.stick_count())
+    throw std::invalid_argument("sharpen: segmentation does not match the surface");
+  FlatSegmentation none;
+  const FlatSegmentation& seg = flats.region.empty() ? none : flats;
+  if (flats.region.empty()) none.region.assign(surface.stick_count(), -1);
+  if (none.region.size()) none.junction.assign(surface.stick_count(), 0);
+  Sharpener sh(surface, seg, options);
+  return sh.run();
+}
+
+}  // namespace voxpress

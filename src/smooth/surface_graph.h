@@ -1,0 +1,71 @@
+// Private helpers shared by the flats detector and the sharpener: oriented
+// planes, least-squares plane fits, and the vertex adjacency of a triangle
+// set (index space throughout).
+#pragma once
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "voxpress/core/types.h"
+
+namespace voxpress::detail {
+
+// Oriented plane n . x = c (index space), inside at n . x < c.
+struct Plane {
+  Vec3 n{0, 0, 1};
+  double c = 0;
+};
+
+// Principal axes of points: mean, eigenvalues ascending, the smallest's axis.
+struct Pca {
+  Vec3 mean, eigenvalues, normal;
+};
+inline Pca pca(const std::vector<Vec3>& pts) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : pts) mean += p;
+  mean /= double(pts.size());
+  Mat3 cov = Mat3::Zero();
+  for (const Vec3& p : pts) cov += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  return {mean, es.eigenvalues(), es.eigenvectors().col(0)};
+}
+
+// Least-squares plane (orthogonal PCA) of points, oriented along `towards`.
+inline Plane fit_plane(const std::vector<Vec3>& pts, const Vec3& towards) {
+  const Pca q = pca(pts);
+  const Vec3 n = q.normal.dot(towards) < 0 ? Vec3(-q.normal) : q.normal;
+  return {n, n.dot(q.mean)};
+}
+
+// Vertex adjacency of `n` vertices from triangles (CSR: the neighbours of v
+// are adj[off[v] .. off[v + 1]), sorted, each once).
+inline void vertex_adjacency(size_t n, const std::vector<Triangle>& triangles, std::vector<uint32_t>& off,
+                             std::vector<uint32_t>& adj) {
+  off.assign(n + 1, 0);
+  for (const Triangle& tr : triangles)
+    for (uint32_t v : tr) off[v + 1] += 2;
+  for (size_t v = 0; v < n; ++v) off[v + 1] += off[v];
+  adj.resize(off[n]);
+  std::vector<uint32_t> fill(off.begin(), off.end() - 1);
+  for (const Triangle& tr : triangles)
+    for (int e = 0; e < 3; ++e) {
+      adj[fill[tr[size_t(e)]]++] = tr[size_t((e + 1) % 3)];
+      adj[fill[tr[size_t(e)]]++] = tr[size_t((e + 2) % 3)];
+    }
+  // Deduplicate each list in place, then compact.
+  uint32_t out = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const uint32_t b = off[v], e = off[v + 1];
+    std::sort(adj.begin() + b, adj.begin() + e);
+    const uint32_t start = out;
+    for (uint32_t k = b; k < e; ++k)
+      if (k == b || adj[k] != adj[k - 1]) adj[out++] = adj[k];
+    off[v] = start;
+  }
+  off[n] = out;
+  adj.resize(out);
+}
+
+}  // namespace voxpress::detail

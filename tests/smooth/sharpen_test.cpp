@@ -1,0 +1,244 @@
+// Sharp edge recovery: accuracy against exactly known solids (box, CAD-like
+// part, fandisk when ../shared is present), the recovered creases, the
+// guarantees on the property corpus, the subdivision bookkeeping, the
+// segmented output and determinism.
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "test_util.h"
+#include "voxpress/eval/checks.h"
+#include "voxpress/eval/metrics.h"
+#include "voxpress/eval/truth.h"
+#include "voxpress/eval/voxelize.h"
+#include "voxpress/smooth/sharpen.h"
+
+namespace voxpress {
+namespace {
+
+struct Sharpened {
+  StickSurface surface;
+  FlatSegmentation seg;
+  Mesh before, after;  // pressed with flats, then sharpened
+  SharpenStats stats;
+};
+
+Sharpened run(const BinaryVolume& volume, const FlatOptions& fo = {}, const PressOptions& po = {},
+              const SharpenOptions& so = {}) {
+  Sharpened r;
+  r.surface = extract_sticks(volume);
+  press_with_flats(r.surface, build_slice_curves(r.surface), po, &fo, &r.seg);
+  r.before = to_mesh(r.surface);
+  SharpenResult sr = sharpen(r.surface, r.seg, so);
+  r.after = std::move(sr.mesh);
+  r.stats = sr.stats;
+  return r;
+}
+
+GeneratedShape shape(ShapeKind kind, int64_t res, int seed) {
+  GenerateOptions go;
+  go.res = res;
+  go.rotation = parse_rotation("random:" + std::to_string(seed));
+  return generate_shape(kind, go);
+}
+
+void expect_valid(const Mesh& m, const BinaryVolume& v) {
+  const MeshCheck mc = check_mesh(m);
+  EXPECT_TRUE(mc.ok()) << (mc.problems.empty() ? "" : mc.problems[0]);
+  EXPECT_EQ(check_classification(m, v).violations, 0u);
+}
+
+EvalReport eval(const Mesh& m, const Truth& truth, const BinaryVolume& v) {
+  EvalOptions eo;
+  eo.volume = &v;
+  eo.samples = 60000;
+  eo.self_intersections = false;
+  return evaluate(m, truth, eo);
+}
+
+Vec3 face_normal(const Mesh& m, size_t f) {
+  const Triangle& t = m.triangles[f];
+  return (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]).normalized();
+}
+
+TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
+  for (int seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE("box 128 seed " + std::to_string(seed));
+    const GeneratedShape g = shape(ShapeKind::box, 128, seed);
+    const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation);
+    const Sharpened r = run(g.volume);
+    ASSERT_EQ(r.seg.flats.size(), 6u);
+    expect_valid(r.after, g.volume);
+    const EvalReport before = eval(r.before, *truth, g.volume), after = eval(r.after, *truth, g.volume);
+    EXPECT_LT(after.result_to_truth_vox.rms, 0.6 * before.result_to_truth_vox.rms);
+    EXPECT_LT(after.normal_error_deg, before.normal_error_deg);
+    EXPECT_GE(r.stats.corners, 8u) << "at least one corner vertex per box corner";
+    ASSERT_TRUE(after.sharp_edge_hausdorff_vox.has_value());
+    // The target is 0.15 voxel both ways; measured 0.27-2.0 at the
+    // worst point (near corners; docs/BENCHMARKS.md), so this only guards
+    // against regressions: every true edge has a labelled one nearby.
+    EXPECT_LT(*after.sharp_true_to_labelled_vox, 2.5);
+    EXPECT_LT(*after.sharp_edge_hausdorff_vox, 2.5);
+    // Dihedral angles across the labelled edges: the box's 90 degrees.
+    std::map<std::pair<uint32_t, uint32_t>, std::vector<size_t>> faces;
+    for (size_t f = 0; f < r.after.face_count(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t a = r.after.triangles[f][size_t(k)], b = r.after.triangles[f][size_t((k + 1) % 3)];
+        faces[{std::min(a, b), std::max(a, b)}].push_back(f);
+      }
+    size_t within = 0;
+    for (const auto& e : r.after.edges) {
+      const auto& fs = faces.at({std::min(e[0], e[1]), std::max(e[0], e[1])});
+      ASSERT_EQ(fs.size(), 2u);
+      const double angle =
+          std::acos(std::clamp(face_normal(r.after, fs[0]).dot(face_normal(r.after, fs[1])), -1.0, 1.0)) * 180 /
+          std::numbers::pi;
+      within += std::abs(angle - 90) <= 5;
+    }
+    EXPECT_GE(double(within), 0.95 * double(r.after.edges.size()));
+  }
+}
+
+TEST(Sharpen, CadPartErrorDropsAndGuaranteesHold) {
+  for (int seed = 2; seed <= 3; ++seed) {
+    SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
+    const GeneratedShape g = shape(ShapeKind::cad_part, 128, seed);
+    const Sharpened r = run(g.volume);
+    expect_valid(r.after, g.volume);
+    Mesh tm = cad_part_mesh();
+    for (Vec3& p : tm.positions) p = g.translation + g.linear * p;
+    const auto t = mesh_truth(std::move(tm), "cad part");
+    const EvalReport before = eval(r.before, *t, g.volume), after = eval(r.after, *t, g.volume);
+    EXPECT_LT(after.result_to_truth_vox.rms, before.result_to_truth_vox.rms);
+    EXPECT_LT(after.normal_error_deg, before.normal_error_deg);
+    EXPECT_GT(r.after.edges.size(), 0u);
+  }
+}
+
+TEST(Sharpen, SubdivisionFollowsFigure8) {
+  const GeneratedShape g = shape(ShapeKind::box, 48, 4);
+  const Sharpened r = run(g.volume);
+  // Each chamfer triangle becomes 2, 3 or 6; the others are kept.
+  const size_t orig = r.surface.triangles.size();
+  EXPECT_GT(r.after.face_count(), orig);
+  EXPECT_LE(r.after.face_count(), orig + 5 * r.stats.chamfer_triangles);
+  EXPECT_GE(r.after.face_count(), orig + r.stats.chamfer_triangles);
+  EXPECT_EQ(r.after.vertex_count(), r.surface.stick_count() + r.stats.inserted + r.stats.corners);
+  EXPECT_EQ(r.stats.inserted, r.stats.chamfer_edges);
+  // Euler characteristic unchanged (a sphere).
+  const MeshCheck mc = check_mesh(r.after);
+  EXPECT_EQ(mc.euler, 2);
+  // Faces of a flat lie on its plane.
+  const MeshAttribute* region = r.after.face_attribute("region");
+  ASSERT_NE(region, nullptr);
+  size_t on_plane = 0, flat_faces = 0;
+  for (size_t f = 0; f < r.after.face_count(); ++f) {
+    const int32_t id = int32_t(region->values[f]);
+    if (id < 0) continue;
+    ++flat_faces;
+    const Flat& fl = r.seg.flats[size_t(id)];
+    bool all = true;
+    for (uint32_t v : r.after.triangles[f]) all &= std::abs(fl.normal.dot(r.after.positions[v]) - fl.offset) < 1e-6;
+    on_plane += all;
+  }
+  EXPECT_GT(flat_faces, r.after.face_count() / 2);
+  // (not all: a leftover vertex whose projection would cross a sample stays short of the plane)
+  EXPECT_GE(double(on_plane), 0.9 * double(flat_faces));
+}
+
+TEST(Sharpen, PropertyCorpusKeepsEveryGuarantee) {
+  FlatOptions fo;
+  fo.min_area = 4;  // small volumes: let flats, junctions and chamfers happen
+  fo.min_width = 1;
+  PressOptions po;
+  po.iterations = 30;
+  size_t sharpened = 0;
+  for (const test::Case& c : test::property_volumes()) {
+    SCOPED_TRACE(c.name);
+    const Sharpened r = run(c.volume, fo, po);
+    expect_valid(r.after, c.volume);
+    sharpened += r.stats.inserted > 0;
+    for (const auto& e : r.after.edges) ASSERT_TRUE(e[0] < r.after.vertex_count() && e[1] < r.after.vertex_count());
+  }
+  EXPECT_GT(sharpened, 5u) << "the corpus exercises the sharpening";
+}
+
+TEST(Sharpen, AdversarialRotatedBoxUnionsKeepEveryGuarantee) {
+  // Unions of small rotated boxes: many flats, concave creases, corners of
+  // three or more faces and thin slabs, at low resolution.
+  test::Rng rng(17);
+  for (int k = 0; k < 12; ++k) {
+    SCOPED_TRACE("union " + std::to_string(k));
+    const int64_t n = 28;
+    BinaryVolume v = test::make_volume(n, n, n);
+    for (int b = 0; b < 3; ++b) {
+      const GeneratedShape g = shape(ShapeKind::box, 12 + int64_t(rng.range(0, 8)), int(rng.range(1, 1000)));
+      const auto& d = g.volume.lattice.dims;
+      const int64_t ox = rng.range(0, n - d[0]), oy = rng.range(0, n - d[1]), oz = rng.range(0, n - d[2]);
+      for (int64_t z = 0; z < d[2]; ++z)
+        for (int64_t y = 0; y < d[1]; ++y)
+          for (int64_t x = 0; x < d[0]; ++x)
+            if (g.volume.at(x, y, z) && ox + x < n && oy + y < n && oz + z < n)
+              v.inside[v.lattice.linear(ox + x, oy + y, oz + z)] = 1;
+    }
+    FlatOptions fo;
+    fo.min_area = 10;
+    const Sharpened r = run(v, fo);
+    expect_valid(r.after, v);
+  }
+}
+
+TEST(Sharpen, SameResultForOneAndManyThreads) {
+  const GeneratedShape g = shape(ShapeKind::cad_part, 72, 3);
+  Sharpened a, b;
+  {
+    tbb::task_arena arena(1);
+    arena.execute([&] { a = run(g.volume); });
+  }
+  {
+    tbb::task_arena arena(std::max(2, tbb::info::default_concurrency()));
+    arena.execute([&] { b = run(g.volume); });
+  }
+  EXPECT_EQ(a.after.positions, b.after.positions);
+  EXPECT_EQ(a.after.triangles, b.after.triangles);
+  EXPECT_EQ(a.after.edges, b.after.edges);
+}
+
+TEST(Sharpen, WithoutFlatsItIsThePressedMesh) {
+  const GeneratedShape g = shape(ShapeKind::sphere, 40, 1);
+  StickSurface s = extract_sticks(g.volume);
+  FlatSegmentation none;
+  press_with_flats(s, build_slice_curves(s), {}, nullptr, &none);
+  const SharpenResult r = sharpen(s, none);
+  const Mesh m = to_mesh(s);
+  EXPECT_EQ(r.mesh.positions, m.positions);
+  EXPECT_EQ(r.mesh.triangles, m.triangles);
+  EXPECT_TRUE(r.mesh.edges.empty());
+  EXPECT_EQ(r.stats.inserted, 0u);
+}
+
+TEST(Sharpen, SharpAngleOptionControlsTheLabels) {
+  const GeneratedShape g = shape(ShapeKind::box, 128, 1);
+  SharpenOptions strict;
+  strict.sharp_angle = 120;  // the box's creases are 90 degrees: none is labelled
+  const Sharpened a = run(g.volume), b = run(g.volume, {}, {}, strict);
+  EXPECT_GT(a.after.edges.size(), 0u);
+  EXPECT_TRUE(b.after.edges.empty());
+  EXPECT_EQ(a.after.positions, b.after.positions) << "labels only: the geometry is the same";
+}
+
+TEST(Sharpen, FandiskGetsMoreAccurate) {
+  VOXPRESS_REQUIRE_SHARED_DATA();
+  const test::VoxelizedModel v = test::voxelized_shared_model("fandisk.off", 128, 1);
+  const Sharpened r = run(v.volume);
+  expect_valid(r.after, v.volume);
+  const EvalReport before = eval(r.before, *v.truth, v.volume), after = eval(r.after, *v.truth, v.volume);
+  EXPECT_LT(after.result_to_truth_vox.rms, before.result_to_truth_vox.rms);
+  EXPECT_GT(r.after.edges.size(), 0u);
+}
+
+}  // namespace
+}  // namespace voxpress
