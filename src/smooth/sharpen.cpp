@@ -26,6 +26,8 @@ constexpr int kRounds = 8;       // passes over the new vertices' moves
 
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
 
+double degrees_between(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / kPi; }
+
 // Is z in the closed tetrahedron (a, b, c, d)? A flat tetrahedron counts z
 // when z is coplanar with it (conservative).
 bool in_closed_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z) {
@@ -60,7 +62,7 @@ Vec3 solve_planes(const Plane* planes, int count, const Vec3& x0, double floor) 
 
 struct NewVertex {
   uint32_t a = kNone, b = kNone;  // edge vertex: the chamfer edge's ends; corner: kNone
-  uint32_t tri = kNone;           // corner: its original triangle
+  bool corner = false;            // a corner vertex (three chamfer edges), not an edge vertex
   Vec3 target = Vec3::Zero();
   Vec3 along = Vec3::Zero();      // edge vertex between two planes: their intersection line's direction
   bool moves = false;             // has a target away from where it was inserted
@@ -76,7 +78,6 @@ struct Sharpener {
   std::vector<uint32_t> adj_off, adj;       // original vertex adjacency
   std::vector<Vec3> x;                      // positions (index space): original, then new
   std::vector<Triangle> tris;               // the refined triangles
-  std::vector<uint32_t> parent;             // original triangle of each refined triangle
   std::vector<NewVertex> nv;                // new vertex n + k
   std::vector<std::array<uint32_t, 2>> feature_edges;  // new edges between new vertices
   std::vector<int32_t> label;               // per original vertex: flat id or -1 (seg.region + leftovers)
@@ -84,8 +85,7 @@ struct Sharpener {
   std::vector<int8_t> plane_state;          // per original vertex: 0 unknown, 1 has plane, -1 none
   std::vector<Plane> plane;
   std::vector<uint32_t> fan_off, fan;       // triangles around each vertex (CSR)
-  std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;  // refined triangles by parent cell bucket
-  std::vector<std::array<int64_t, 3>> tri_cell;                 // per original triangle
+  std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;  // refined triangles by their first vertex's bucket
   SharpenStats st;
 
   Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
@@ -94,9 +94,7 @@ struct Sharpener {
   }
 
   Vec3 physical_normal(const Vec3& index_normal) const { return (Minv_t * index_normal).normalized(); }
-  double angle_deg(const Vec3& na, const Vec3& nb) const {
-    return std::acos(std::clamp(physical_normal(na).dot(physical_normal(nb)), -1.0, 1.0)) * 180 / kPi;
-  }
+  double angle_deg(const Vec3& na, const Vec3& nb) const { return degrees_between(physical_normal(na), physical_normal(nb)); }
 
   // The plane of an original vertex's side (Section 5): its flat's plane, or
   // for a curved vertex the least-squares plane of the fresh, non-junction
@@ -113,13 +111,7 @@ struct Sharpener {
       return &plane[v];
     }
     std::vector<uint32_t> ring{v};
-    for (int k = 0; k < 2; ++k) {
-      const size_t end = ring.size();
-      for (size_t i = 0; i < end; ++i)
-        for (uint32_t q = adj_off[ring[i]]; q < adj_off[ring[i] + 1]; ++q) ring.push_back(adj[q]);
-      std::sort(ring.begin(), ring.end());
-      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-    }
+    detail::grow_rings(ring, 2, adj_off, adj);
     std::vector<Vec3> pts;
     Vec3 towards = Vec3::Zero();
     for (int pass = 0; pass < 2 && pts.size() < 3; ++pass) {
@@ -134,7 +126,7 @@ struct Sharpener {
     if (pts.size() < 3) return nullptr;
     const detail::Pca p = detail::pca(pts);
     if (!(p.eigenvalues[1] > 1e-6)) return nullptr;  // collinear points
-    plane[v] = detail::fit_plane(pts, towards);
+    plane[v] = detail::oriented_plane(p, towards);
     plane_state[v] = 1;
     return &plane[v];
   }
@@ -145,9 +137,7 @@ struct Sharpener {
     const int32_t a = label[u], b = label[v];
     if (a == b) return false;
     if (a >= 0 && b >= 0) {
-      const Vec3& na = seg.flats[size_t(a)].normal;
-      const Vec3& nb = seg.flats[size_t(b)].normal;
-      return std::acos(std::clamp(na.dot(nb), -1.0, 1.0)) * 180 / kPi >= o.min_angle;
+      return degrees_between(seg.flats[size_t(a)].normal, seg.flats[size_t(b)].normal) >= o.min_angle;
     }
     return seg.junction[a < 0 ? u : v] != 0;
   }
@@ -187,11 +177,7 @@ struct Sharpener {
       double best_d = INFINITY;
       ring.assign(1, v);
       for (int r = 0; r < 3 && best < 0; ++r) {
-        const size_t end = ring.size();
-        for (size_t i = 0; i < end; ++i)
-          for (uint32_t k = adj_off[ring[i]]; k < adj_off[ring[i] + 1]; ++k) ring.push_back(adj[k]);
-        std::sort(ring.begin(), ring.end());
-        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+        detail::grow_rings(ring, 1, adj_off, adj);
         for (uint32_t q : ring) {
           const int32_t f = label[q];
           if (f < 0) continue;
@@ -266,10 +252,7 @@ struct Sharpener {
         m[e] = chamfer(a, b) ? edge_vertex(a, b) : kNone;
         k += m[e] != kNone;
       }
-      auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
-        tris.push_back({a, b, c});
-        parent.push_back(uint32_t(f));
-      };
+      auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { tris.push_back({a, b, c}); };
       if (k == 0) {
         emit(t[0], t[1], t[2]);
         continue;
@@ -296,7 +279,7 @@ struct Sharpener {
         feature_edges.push_back({m01, m20});
       } else {  // Fig. 8c: six triangles around a corner vertex
         NewVertex c;
-        c.tri = uint32_t(f);
+        c.corner = true;
         const Vec3 start = (x[m[0]] + x[m[1]] + x[m[2]]) / 3;
         const Plane* p[3] = {plane_of(t[0]), plane_of(t[1]), plane_of(t[2])};
         c.target = start;
@@ -448,7 +431,7 @@ struct Sharpener {
         ++chain_degree[a];
       }
   }
-  bool inner(uint32_t i) const { return chain_degree[i] == 2 && nv[i].tri == kNone; }
+  bool inner(uint32_t i) const { return chain_degree[i] == 2 && !nv[i].corner; }
 
   // Beyond the paper: targets on an intersection line are the projections
   // of where the vertices were inserted, which bunch up (or even swap) where
@@ -513,8 +496,6 @@ struct Sharpener {
       subdivide();
     } else {
       tris = s.triangles;
-      parent.resize(tris.size());
-      for (size_t f = 0; f < tris.size(); ++f) parent[f] = uint32_t(f);
     }
     if (!nv.empty()) {
       index();
@@ -531,7 +512,7 @@ struct Sharpener {
       }
       for (int corners = 0; corners < 2; ++corners)
         for (size_t i = 0; i < nv.size(); ++i)
-          if (nv[i].moves && (nv[i].tri != kNone) == bool(corners)) jobs.push_back({uint32_t(n + i), nv[i].target});
+          if (nv[i].moves && nv[i].corner == bool(corners)) jobs.push_back({uint32_t(n + i), nv[i].target});
       std::vector<uint8_t> done(jobs.size(), 0);
       // Neighbours that block each other (two vertices of one thin triangle)
       // get there together: a blocked vertex goes half way instead.
@@ -571,7 +552,7 @@ struct Sharpener {
     for (const auto& e : feature_edges) {
       const NewVertex& a = nv[e[0] - n];
       const NewVertex& b = nv[e[1] - n];
-      const bool sharp = (a.tri != kNone || a.sharp) && (b.tri != kNone || b.sharp);
+      const bool sharp = (a.corner || a.sharp) && (b.corner || b.sharp);
       if (!sharp) continue;
       m.edges.push_back(e);
       feature.values[e[0]] = feature.values[e[1]] = 1;
@@ -605,11 +586,9 @@ struct Sharpener {
 SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options) {
   if (!flats.region.empty() && flats.region.size() != surface.stick_count())
     throw std::invalid_argument("sharpen: segmentation does not match the surface");
-  FlatSegmentation none;
-  const FlatSegmentation& seg = flats.region.empty() ? none : flats;
+  FlatSegmentation none;  // no segmentation: every vertex curved
   if (flats.region.empty()) none.region.assign(surface.stick_count(), -1);
-  if (none.region.size()) none.junction.assign(surface.stick_count(), 0);
-  Sharpener sh(surface, seg, options);
+  Sharpener sh(surface, flats.region.empty() ? none : flats, options);
   return sh.run();
 }
 

@@ -32,11 +32,25 @@ inline Pca pca(const std::vector<Vec3>& pts) {
   return {mean, es.eigenvalues(), es.eigenvectors().col(0)};
 }
 
-// Least-squares plane (orthogonal PCA) of points, oriented along `towards`.
-inline Plane fit_plane(const std::vector<Vec3>& pts, const Vec3& towards) {
-  const Pca q = pca(pts);
+// The least-squares plane of a PCA, oriented along `towards`.
+inline Plane oriented_plane(const Pca& q, const Vec3& towards) {
   const Vec3 n = q.normal.dot(towards) < 0 ? Vec3(-q.normal) : q.normal;
   return {n, n.dot(q.mean)};
+}
+
+// Least-squares plane (orthogonal PCA) of points, oriented along `towards`.
+inline Plane fit_plane(const std::vector<Vec3>& pts, const Vec3& towards) { return oriented_plane(pca(pts), towards); }
+
+// Grows `ring` (sorted, unique vertex ids) by `rings` rings of neighbours.
+inline void grow_rings(std::vector<uint32_t>& ring, int rings, const std::vector<uint32_t>& off,
+                       const std::vector<uint32_t>& adj) {
+  for (int k = 0; k < rings; ++k) {
+    const size_t end = ring.size();
+    for (size_t i = 0; i < end; ++i)
+      for (uint32_t q = off[ring[i]]; q < off[ring[i] + 1]; ++q) ring.push_back(adj[q]);
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+  }
 }
 
 // Vertex adjacency of `n` vertices from triangles (CSR: the neighbours of v
