@@ -6,33 +6,14 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
-#include <cmath>
-
+#include "organic.h"
 #include "voxpress/voxpress.h"
 
 namespace {
 
 using namespace voxpress;
 
-const BinaryVolume& organic() {
-  static const BinaryVolume v = [] {
-    BinaryVolume b;
-    const int64_t n = 256;
-    b.lattice.dims = {n, n, n};
-    b.inside.resize(size_t(n * n * n));
-    const double w = 2 * M_PI / 46.0;  // gyroid period: 46 voxels
-    for (int64_t k = 0; k < n; ++k)
-      for (int64_t j = 0; j < n; ++j)
-        for (int64_t i = 0; i < n; ++i) {
-          const double x = double(i) - 127.5, y = double(j) - 127.3, z = double(k) - 127.1;
-          const double g = std::sin(w * x) * std::cos(w * y) + std::sin(w * y) * std::cos(w * z) +
-                           std::sin(w * z) * std::cos(w * x);
-          b.inside[b.lattice.linear(i, j, k)] = x * x + y * y + z * z < 120.0 * 120.0 && g > 0.2;
-        }
-    return b;
-  }();
-  return v;
-}
+using bench::organic;
 
 void Press(benchmark::State& state) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, size_t(state.range(0)));

@@ -23,6 +23,10 @@ echo "== distance to the exact part: midpoint surface, Pressing without flats, P
 "$vp" eval "$out/part-midpoint.ply" --volume "$out/part.nrrd" --samples 100000 --json "$out/eval-midpoint.json"
 "$vp" eval "$out/part-noflats.ply" --volume "$out/part.nrrd" --samples 100000 --json "$out/eval-noflats.json"
 "$vp" eval "$out/part-pressed.ply" --volume "$out/part.nrrd" --samples 100000 --json "$out/eval-pressed.json"
+echo "== without the volume: the midpoint STL smoothed inside Bade's diamonds, then checked against the volume"
+"$vp" -q extract "$out/part.nrrd" -o "$out/part-midpoint.stl"
+"$vp" smooth-mesh "$out/part-midpoint.stl" -o "$out/part-diamond.ply" --constraint diamond
+"$vp" check "$out/part-diamond.ply" --volume "$out/part.nrrd"
 echo "== 2D: the contours of a small binary image, pressed"
 "$vp" press2d "$root/examples/shapes.pbm" -o "$out/shapes.svg" --midpoint
-echo "== wrote $out/: part.nrrd, part-midpoint.ply, part-noflats.ply, part-pressed.ply/.glb (vertex colours = flats), press.json, eval-*.json, shapes.svg"
+echo "== wrote $out/: part.nrrd, part-midpoint.ply, part-noflats.ply, part-pressed.ply/.glb (vertex colours = flats), part-diamond.ply, press.json, eval-*.json, shapes.svg"

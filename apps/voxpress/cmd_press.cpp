@@ -16,7 +16,92 @@ struct PressCmd {
   std::string features;
   bool no_flats = false, no_sharpen = false, color_regions = false;
   bool ascii = false, check = false;
+  std::string method = "pressing";
+  MethodParams params;
+  CLI::App* cmd = nullptr;
 };
+
+constexpr const char* kMethods = "pressing, cesn, diamond, cell-edge, cell-size, taubin or laplacian";
+
+// --method other than pressing: the midpoint surface smoothed by a baseline
+// (CESN from the volume; Bade's constraints with the lattice known, no
+// recovery needed; Taubin / Laplacian unconstrained).
+void run_other_method(const PressCmd& c, const Global& g) {
+  for (const char* name : {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend",
+                           "--flat-width", "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations",
+                           "--features", "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting",
+                           "--plain"})
+    if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
+  const std::optional<FairOptions::Kind> kind = fair_kind(c.method);
+  MeshConstraint constraint = MeshConstraint::diamond;
+  if (!kind && c.method != "cesn") {
+    try {
+      constraint = parse_constraint(c.method);
+    } catch (const UsageError&) {
+      throw UsageError("--method must be " + std::string(kMethods) + " (got '" + c.method + "')");
+    }
+  }
+  if (!kind && (c.params.lambda || c.params.mu)) throw UsageError("--lambda and --mu apply to taubin and laplacian only");
+  MethodParams params = c.params;
+  if (c.smooth.iterations_option->count()) params.iterations = c.smooth.options.iterations;
+  if (c.smooth.tolerance_option->count()) params.tolerance = c.smooth.options.tolerance;
+  Stopwatch clock;
+  ProgressBar bar(!g.quiet);
+  VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());
+  Mesh mesh;
+  nlohmann::json method_json;
+  double seconds_smooth = 0;
+  int iterations = 0;
+  if (c.method == "cesn") {
+    SurfaceNetStats st;
+    mesh = constrained_surface_net(vs.surface, params.surface_net(bar.get()), &st);
+    method_json = {{"iterations", st.iterations},      {"converged", st.converged},
+                   {"last_max_change", st.last_max_change}, {"patch_vertices", st.patch_vertices},
+                   {"split_cells", st.split_cells},    {"face_vertices", st.face_vertices},
+                   {"quads", st.quads},                {"seconds_build", st.seconds_build},
+                   {"seconds_relax", st.seconds_relax}};
+    seconds_smooth = st.seconds_build + st.seconds_relax;
+    iterations = st.iterations;
+  } else {
+    SmoothStats st;
+    if (kind) {
+      mesh = to_mesh(vs.surface);
+      st = fair(mesh, params.fairing(*kind, bar.get()));
+    } else {
+      LatticeMesh lm = lattice_mesh(vs.surface);
+      st = constrained_smooth(lm, params.constrained(constraint, bar.get()));
+      mesh = std::move(lm.mesh);
+    }
+    method_json = smooth_stats_json(st);
+    seconds_smooth = st.seconds;
+    iterations = st.iterations;
+  }
+  // Only cell-edge and diamond promise the in/out guarantee; the others'
+  // checks are reported, not enforced.
+  const bool strict = !kind && c.method != "cesn" && constraint != MeshConstraint::cell_size;
+  const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), c.method, strict) : nlohmann::json();
+  MeshWriteOptions wo;
+  wo.ascii = c.ascii;
+  write_mesh(c.output, mesh, wo);
+  if (!g.quiet) {
+    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %s, %d iterations\n", c.output.c_str(), mesh.vertex_count(),
+                 mesh.face_count(), c.method.c_str(), iterations);
+    if (c.check && !strict)
+      std::fprintf(stderr, "%s: %llu samples on the wrong side, %zu self-intersections (%s promises neither)\n",
+                   c.output.c_str(), (unsigned long long)checks["classification_violations"].get<uint64_t>(),
+                   checks["self_intersections"].get<size_t>(), c.method.c_str());
+  }
+  if (!c.stats_json.empty()) {
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, vs, mesh);
+    j["method"] = c.method;
+    j["smoothing"] = method_json;
+    j["seconds"] = {{"read", vs.seconds_read}, {"extract", vs.seconds_extract}, {"smooth", seconds_smooth},
+                    {"total", clock.seconds()}};
+    j["peak_memory_bytes"] = peak_rss_bytes();
+    if (c.check) j["checks"] = checks;
+    write_json(c.stats_json, j);
+  }
+}
 
 nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
   nlohmann::json list = nlohmann::json::array();
@@ -78,6 +163,8 @@ void write_features(const std::string& path, const Mesh& mesh) {
 
 void run_press(const PressCmd& c, const Global& g) {
   mesh_format_from_path(c.output);  // a bad extension fails before any work
+  if (c.method != "pressing") return run_other_method(c, g);
+  if (c.params.lambda || c.params.mu) throw UsageError("--lambda and --mu apply to taubin and laplacian only");
   if (!c.features.empty()) {
     const MeshFormat ff = mesh_format_from_path(c.features);
     if (ff != MeshFormat::ply && ff != MeshFormat::obj) throw UsageError("--features must be a .ply or .obj file");
@@ -144,8 +231,13 @@ void register_press(CLI::App& app, Global& g) {
                                           "so no sample changes side)");
   cmd->add_option("input", c->input, "Volume file (or folder of TIFF slices)")->required();
   cmd->add_option("-o,--output", c->output, "Output mesh (.ply .obj .stl .off .glb .gltf)")->required();
+  c->cmd = cmd;
+  cmd->add_option("--method", c->method, std::string("Smoothing method: ") + kMethods +
+                                             " (see docs/ARCHITECTURE.md; all but pressing are baselines)")
+      ->capture_default_str();
   c->in.bind(*cmd);
   c->smooth.bind(*cmd);
+  c->params.bind_fairing(*cmd->add_option_group("fairing", "Taubin / Laplacian (--method taubin|laplacian)"));
   auto* f = cmd->add_option_group("flats", "Flats (plane voting) and junctions");
   f->add_flag("--no-flats", c->no_flats, "Do not look for flats: every vertex is smoothed");
   f->add_option("--min-flat-area", c->flats.min_area, "Smallest flat, in cell areas")->capture_default_str();

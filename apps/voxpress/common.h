@@ -84,17 +84,35 @@ struct PressCli {
   PressOptions options;
   std::string weighting = "equal";
   bool plain = false;
+  CLI::Option* iterations_option = nullptr;  ///< to tell a given --iterations from the default
+  CLI::Option* tolerance_option = nullptr;
   void bind(CLI::App& cmd);
   /// The options with the weighting and --plain applied; throws UsageError.
   PressOptions resolve() const;
 };
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o);
 
+/// The parameters of the methods other than Pressing (Bade's constraints,
+/// CESN, Taubin, Laplacian); unset ones take each method's default.
+struct MethodParams {
+  std::optional<int> iterations;
+  std::optional<double> tolerance, lambda, mu;
+  /// Adds --lambda and --mu (Taubin / Laplacian) to a command or group.
+  void bind_fairing(CLI::App& cmd);
+  ConstrainedOptions constrained(MeshConstraint c, Progress* progress) const;
+  SurfaceNetOptions surface_net(Progress* progress) const;
+  FairOptions fairing(FairOptions::Kind kind, Progress* progress) const;
+};
+/// "taubin" or "laplacian" -> its kind; nullopt otherwise.
+std::optional<FairOptions::Kind> fair_kind(const std::string& method);
+nlohmann::json smooth_stats_json(const SmoothStats& st);
+
 /// `--check` of extract and press: check_mesh and the classification against
-/// the volume, before anything is written. Throws Error ("the <what> surface
-/// failed its checks: ...") on a failure; returns the "checks" object for
-/// --stats-json.
-nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what);
+/// the volume, before anything is written. When strict (methods that promise
+/// both), throws Error ("the <what> surface failed its checks: ...") on a
+/// failure; returns the "checks" object for --stats-json.
+nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what,
+                             bool strict = true);
 
 /// --res --rotate --spacing --margin: how generate and voxelize place a solid
 /// on a new lattice (GenerateOptions and VoxelizeOptions share these fields).
@@ -140,5 +158,6 @@ void register_voxelize(CLI::App& app, Global& g);
 void register_eval(CLI::App& app, Global& g);
 void register_press(CLI::App& app, Global& g);
 void register_press2d(CLI::App& app, Global& g);
+void register_smooth_mesh(CLI::App& app, Global& g);
 
 }  // namespace voxpress::cli

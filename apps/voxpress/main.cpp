@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   cli::register_eval(app, g);
   cli::register_press(app, g);
   cli::register_press2d(app, g);
+  cli::register_smooth_mesh(app, g);
 
   try {
     app.parse(argc, argv);

@@ -17,7 +17,9 @@
 #include "voxpress/io/volume_io.h"
 #include "voxpress/smooth/flats.h"
 #include "voxpress/smooth/pressing.h"
+#include "voxpress/smooth/mesh_smoothing.h"
 #include "voxpress/smooth/sharpen.h"
+#include "voxpress/smooth/surface_nets.h"
 
 namespace voxpress {
 inline constexpr const char* kVersion = "0.1.0";

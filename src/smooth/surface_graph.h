@@ -5,9 +5,11 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "voxpress/core/progress.h"
 #include "voxpress/core/types.h"
 
 namespace voxpress::detail {
@@ -80,6 +82,43 @@ inline void vertex_adjacency(size_t n, const std::vector<Triangle>& triangles, s
   }
   off[n] = out;
   adj.resize(out);
+}
+
+// Gauss-Seidel umbrella relaxation (Bade Section 4; Gibson's nets): each
+// iteration visits the vertices in order and sets x[v] = project(v, mean of
+// its neighbours' current positions); stops once no vertex moved more than
+// `threshold` within one iteration, or after max_iterations. Serial, so the
+// result does not depend on the thread count. Vertices without neighbours
+// stay put.
+struct Relaxation {
+  int iterations = 0;
+  double last_max_change = 0;
+  bool converged = false;
+};
+template <class Project>
+Relaxation relax(std::vector<Vec3>& x, const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
+                 Project&& project, double threshold, int max_iterations, ProgressCounter& progress) {
+  Relaxation r;
+  for (int it = 0; it < max_iterations; ++it) {
+    double max_change = 0;
+    for (size_t v = 0; v + 1 < off.size(); ++v) {
+      const uint32_t b = off[v], e = off[v + 1];
+      if (b == e) continue;
+      Vec3 s = Vec3::Zero();
+      for (uint32_t k = b; k < e; ++k) s += x[adj[k]];
+      const Vec3 next = project(v, Vec3(s / double(e - b)));
+      max_change = std::max(max_change, (next - x[v]).squaredNorm());
+      x[v] = next;
+    }
+    r.iterations = it + 1;
+    r.last_max_change = std::sqrt(max_change);
+    progress.add(1);
+    if (r.last_max_change < threshold) {
+      r.converged = true;
+      break;
+    }
+  }
+  return r;
 }
 
 }  // namespace voxpress::detail

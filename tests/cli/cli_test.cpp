@@ -20,14 +20,15 @@ size_t count_lines(const std::string& s) {
 }
 
 TEST(Cli, HelpOnEveryCommand) {
-  for (const std::string cmd : {"", "info", "extract", "generate", "check", "voxelize", "eval", "press", "press2d"}) {
+  for (const std::string cmd : {"", "info", "extract", "generate", "check", "voxelize", "eval", "press", "press2d",
+                                 "smooth-mesh"}) {
     std::string out;
     EXPECT_EQ(run_cli(cmd + " --help", &out), 0) << cmd;
     EXPECT_NE(out.find("Usage"), std::string::npos) << cmd;
   }
   std::string out;
   ASSERT_EQ(run_cli("--help", &out), 0);
-  for (const std::string cmd : {"extract", "press", "press2d", "eval", "voxelize"})
+  for (const std::string cmd : {"extract", "press", "press2d", "eval", "voxelize", "smooth-mesh"})
     EXPECT_NE(out.find(cmd), std::string::npos) << "--help does not list " << cmd;
   EXPECT_EQ(run_cli("--version", &out), 0);
   EXPECT_NE(out.find("voxpress"), std::string::npos);
@@ -424,6 +425,75 @@ TEST(Cli, Press2dWritesContoursOverThePixels) {
   }
   EXPECT_EQ(run_cli("-q press2d " + tmp.path("ring.pgm") + " -o " + tmp.path("o.png"), &out), 2);
   EXPECT_EQ(tmp.files(), before);
+}
+
+TEST(Cli, SmoothMeshRecoversTheLatticeOfAnStlAndKeepsTheGuarantee) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate torus --res 40 --rotate random:2 --spacing 0.7,0.7,1.3 -o " + tmp.path("t.nrrd"), &out), 0)
+      << out;
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("t.nrrd") + " -o " + tmp.path("mc.stl"), &out), 0) << out;
+  for (const std::string c : {"diamond", "cell-edge"}) {
+    ASSERT_EQ(run_cli("-q smooth-mesh " + tmp.path("mc.stl") + " -o " + tmp.path(c + ".ply") + " --constraint " + c +
+                          " --stats-json " + tmp.path(c + ".json"),
+                      &out),
+              0)
+        << out;
+    const auto st = nlohmann::json::parse(std::ifstream(tmp.path(c + ".json")));
+    EXPECT_EQ(st["constraint"], c);
+    EXPECT_NEAR(st["recovered_lattice"]["spacing"][2].get<double>(), 1.3, 1e-5);
+    EXPECT_NEAR(st["recovered_lattice"]["spacing"][0].get<double>(), 0.7, 1e-5);
+    EXPECT_EQ(st["smoothing"]["converged"], true);
+    // Without the volume, and still every sample on its side.
+    EXPECT_EQ(run_cli("check " + tmp.path(c + ".ply") + " --volume " + tmp.path("t.nrrd"), &out), 0) << c << out;
+  }
+  ASSERT_EQ(run_cli("-q smooth-mesh " + tmp.path("mc.stl") + " -o " + tmp.path("t.obj") + " --method taubin --iterations 5",
+                    &out),
+            0)
+      << out;
+  // A smoothed mesh is not a marching-cubes mesh: one line naming the file, exit 1, no output.
+  EXPECT_EQ(run_cli("-q smooth-mesh " + tmp.path("t.obj") + " -o " + tmp.path("bad.ply"), &out), 1);
+  EXPECT_NE(out.find(tmp.path("t.obj") + ": not an axis-aligned marching-cubes mesh"), std::string::npos) << out;
+  EXPECT_EQ(count_lines(out), 1u) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("bad.ply")));
+  EXPECT_EQ(run_cli("-q smooth-mesh " + tmp.path("mc.stl") + " -o " + tmp.path("x.ply") + " --constraint round", &out), 2);
+  EXPECT_EQ(run_cli("-q smooth-mesh " + tmp.path("mc.stl") + " -o " + tmp.path("x.ply") + " --method taubin --constraint diamond",
+                    &out),
+            2);
+  EXPECT_EQ(run_cli("-q smooth-mesh " + tmp.path("mc.stl") + " -o " + tmp.path("x.ply") + " --lambda 0.4", &out), 2);
+  EXPECT_EQ(run_cli("-q smooth-mesh " + tmp.path("none.stl") + " -o " + tmp.path("x.ply"), &out), 1);
+}
+
+TEST(Cli, PressRunsEveryMethodAndChecksOnlyWhatEachPromises) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate sphere --res 32 --rotate random:1 -o " + tmp.path("s.nrrd"), &out), 0) << out;
+  for (const std::string m : {"cesn", "diamond", "cell-edge", "cell-size", "taubin", "laplacian"}) {
+    ASSERT_EQ(run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path(m + ".ply") + " --method " + m +
+                          " --check --stats-json " + tmp.path(m + ".json"),
+                      &out),
+              0)
+        << m << out;
+    const auto st = nlohmann::json::parse(std::ifstream(tmp.path(m + ".json")));
+    EXPECT_EQ(st["method"], m);
+    EXPECT_GT(st["smoothing"]["iterations"].get<int>(), 0) << m;
+    EXPECT_EQ(st["checks"]["closed"], true) << m;
+    EXPECT_EQ(st["checks"]["manifold"], true) << m;
+    if (m == "diamond" || m == "cell-edge") {
+      EXPECT_EQ(st["checks"]["classification_violations"], 0) << m;
+    }
+  }
+  ASSERT_EQ(run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("few.ply") + " --method cesn --iterations 2 "
+                        "--stats-json " + tmp.path("few.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(tmp.path("few.json")))["smoothing"]["iterations"], 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("x.ply") + " --method blur", &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("x.ply") + " --method taubin --no-flats", &out), 2);
+  EXPECT_NE(out.find("--no-flats applies to --method pressing only"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("x.ply") + " --lambda 0.2", &out), 2);
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
 }
 
 }  // namespace
