@@ -241,6 +241,7 @@ SmoothStats constrained_smooth(LatticeMesh& lm, const ConstrainedOptions& o) {
   st.last_max_change = r.last_max_change;
   st.converged = r.converged;
   for (size_t v = 0; v < n; ++v) mesh.positions[v] = lm.lattice.to_physical(x[v]);
+  mesh.normals.clear();  // stale once the vertices moved
   st.seconds = seconds_since(t0);
   return st;
 }

@@ -97,6 +97,7 @@ struct SmoothStats {
 /// the vertices in order and moves each to the mean of its neighbours'
 /// current positions, clipped to its region (Gauss-Seidel, as the paper's
 /// loop; serial, so the result does not depend on the thread count).
+/// Vertex normals, now stale, are dropped; other attributes are kept.
 SmoothStats constrained_smooth(LatticeMesh& mesh, const ConstrainedOptions& options = {});
 
 struct FairOptions {
@@ -111,7 +112,7 @@ struct FairOptions {
 FairOptions fair_defaults(FairOptions::Kind kind);
 
 /// Unconstrained umbrella smoothing of any mesh, in place (simultaneous
-/// updates, parallel, deterministic).
+/// updates, parallel, deterministic). Stale vertex normals are dropped.
 SmoothStats fair(Mesh& mesh, const FairOptions& options = fair_defaults(FairOptions::Kind::taubin));
 
 }  // namespace voxpress
