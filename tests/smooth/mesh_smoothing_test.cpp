@@ -138,6 +138,56 @@ double sphere_normal_error(const Mesh& m, const GeneratedShape& g) {
   return sum / area * 180 / M_PI;
 }
 
+TEST(LatticeRecovery, NeverCrashesOnDamagedOrRandomMeshes) {
+  // Every input either recovers (and then smooths within its regions) or is
+  // refused with an InputError: damaged marching-cubes meshes and triangle soups.
+  Rng rng(11);
+  const Mesh mc = to_mesh(extract_sticks(test::random_blobs(rng, {10, 9, 8}, 3)));
+  size_t accepted = 0, refused = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    Mesh m = mc;
+    switch (trial % 6) {
+      case 0:  // one coordinate nudged by a random fraction of a cell
+        m.positions[rng.range(0, int64_t(m.vertex_count()) - 1)][int(rng.range(0, 2))] += rng.uniform() - 0.5;
+        break;
+      case 1:  // a random triangle soup
+        m.positions.resize(size_t(rng.range(3, 40)));
+        for (Vec3& p : m.positions) p = Vec3(rng.range(-3, 3), rng.range(-3, 3), rng.range(-3, 3)) * 0.5;
+        m.triangles.resize(size_t(rng.range(1, 30)));
+        for (Triangle& t : m.triangles)
+          for (uint32_t& i : t) i = uint32_t(rng.range(0, int64_t(m.vertex_count()) - 1));
+        break;
+      case 2:  // triangles dropped (an open mesh is still marching-cubes-like)
+        m.triangles.resize(size_t(rng.range(1, int64_t(m.face_count()))));
+        break;
+      case 3:  // a vertex moved onto another one
+        m.positions[size_t(rng.range(0, int64_t(m.vertex_count()) - 1))] =
+            m.positions[size_t(rng.range(0, int64_t(m.vertex_count()) - 1))];
+        break;
+      case 4:  // scaled by a huge factor and shifted far away
+        for (Vec3& p : m.positions) p = p * 1e12 + Vec3(1e15, -1e15, 3);
+        break;
+      default:  // everything on one plane
+        for (Vec3& p : m.positions) p.z() = 0;
+        break;
+    }
+    try {
+      LatticeMesh lm = recover_lattice(m, "damaged.ply");
+      ConstrainedOptions o;
+      o.max_iterations = 20;
+      constrained_smooth(lm, o);
+      for (size_t v = 0; v < lm.mesh.vertex_count(); ++v)
+        ASSERT_LE((lm.lattice.to_index(lm.mesh.positions[v]) - lm.midpoint(v)).cwiseAbs().sum(), 0.5);
+      ++accepted;
+    } catch (const InputError& e) {
+      ASSERT_EQ(std::string(e.what()).rfind("damaged.ply: ", 0), 0u) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(accepted, 0u);
+  EXPECT_GT(refused, 0u);
+}
+
 double sphere_rms(const Mesh& m, const GeneratedShape& g) {
   // The sphere's centre and radius in physical space.
   const Vec3 c = g.translation;
