@@ -33,13 +33,13 @@ namespace {
 using namespace voxpress;
 namespace fs = std::filesystem;
 
-struct Method {
+struct CliMethod {
   std::string name;
   std::vector<std::string> args;  // with IN and OUT placeholders
 };
 
 // Methods join this list as they land.
-const std::vector<Method> kMethods = {
+const std::vector<CliMethod> kMethods = {
     {"midpoint", {"extract", "IN", "-o", "OUT"}},
     {"pressing, no flats", {"press", "IN", "-o", "OUT", "--no-flats"}},
     {"pressing, no sharpen", {"press", "IN", "-o", "OUT", "--no-sharpen"}},
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   md << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
 
   auto do_case = [&](Case& c) {
-    for (const Method& m : kMethods) {
+    for (const CliMethod& m : kMethods) {
       const std::string out = (work / (c.name + "-" + m.name + ".ply")).string();
       const std::string stats = (work / "stats.json").string();
       std::vector<std::string> args;

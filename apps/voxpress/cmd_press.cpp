@@ -1,5 +1,5 @@
-// voxpress press IN -o OUT: the midpoint surface smoothed by Pressing, with
-// flats, junctions and sharp edges.
+// voxpress press IN -o OUT: the volume's smooth surface by smooth_surface()
+// — Pressing with flats, junctions and sharp edges, or a baseline method.
 #include <cstdio>
 
 #include "common.h"
@@ -20,88 +20,6 @@ struct PressCmd {
   MethodParams params;
   CLI::App* cmd = nullptr;
 };
-
-constexpr const char* kMethods = "pressing, cesn, diamond, cell-edge, cell-size, taubin or laplacian";
-
-// --method other than pressing: the midpoint surface smoothed by a baseline
-// (CESN from the volume; Bade's constraints with the lattice known, no
-// recovery needed; Taubin / Laplacian unconstrained).
-void run_other_method(const PressCmd& c, const Global& g) {
-  for (const char* name : {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend",
-                           "--flat-width", "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations",
-                           "--features", "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting",
-                           "--plain"})
-    if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
-  const std::optional<FairOptions::Kind> kind = fair_kind(c.method);
-  MeshConstraint constraint = MeshConstraint::diamond;
-  if (!kind && c.method != "cesn") {
-    try {
-      constraint = parse_constraint(c.method);
-    } catch (const UsageError&) {
-      throw UsageError("--method must be " + std::string(kMethods) + " (got '" + c.method + "')");
-    }
-  }
-  if (!kind && (c.params.lambda || c.params.mu)) throw UsageError("--lambda and --mu apply to taubin and laplacian only");
-  MethodParams params = c.params;
-  if (c.smooth.iterations_option->count()) params.iterations = c.smooth.options.iterations;
-  if (c.smooth.tolerance_option->count()) params.tolerance = c.smooth.options.tolerance;
-  Stopwatch clock;
-  ProgressBar bar(!g.quiet);
-  VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());
-  Mesh mesh;
-  nlohmann::json method_json;
-  double seconds_smooth = 0;
-  int iterations = 0;
-  if (c.method == "cesn") {
-    SurfaceNetStats st;
-    mesh = constrained_surface_net(vs.surface, params.surface_net(bar.get()), &st);
-    method_json = {{"iterations", st.iterations},      {"converged", st.converged},
-                   {"last_max_change", st.last_max_change}, {"patch_vertices", st.patch_vertices},
-                   {"split_cells", st.split_cells},    {"face_vertices", st.face_vertices},
-                   {"quads", st.quads},                {"seconds_build", st.seconds_build},
-                   {"seconds_relax", st.seconds_relax}};
-    seconds_smooth = st.seconds_build + st.seconds_relax;
-    iterations = st.iterations;
-  } else {
-    SmoothStats st;
-    if (kind) {
-      mesh = to_mesh(vs.surface);
-      st = fair(mesh, params.fairing(*kind, bar.get()));
-    } else {
-      LatticeMesh lm = lattice_mesh(vs.surface);
-      st = constrained_smooth(lm, params.constrained(constraint, bar.get()));
-      mesh = std::move(lm.mesh);
-    }
-    method_json = smooth_stats_json(st);
-    seconds_smooth = st.seconds;
-    iterations = st.iterations;
-  }
-  // Only cell-edge and diamond promise the in/out guarantee; the others'
-  // checks are reported, not enforced.
-  const bool strict = !kind && c.method != "cesn" && constraint != MeshConstraint::cell_size;
-  const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), c.method, strict) : nlohmann::json();
-  MeshWriteOptions wo;
-  wo.ascii = c.ascii;
-  write_mesh(c.output, mesh, wo);
-  if (!g.quiet) {
-    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %s, %d iterations\n", c.output.c_str(), mesh.vertex_count(),
-                 mesh.face_count(), c.method.c_str(), iterations);
-    if (c.check && !strict)
-      std::fprintf(stderr, "%s: %llu samples on the wrong side, %zu self-intersections (%s promises neither)\n",
-                   c.output.c_str(), (unsigned long long)checks["classification_violations"].get<uint64_t>(),
-                   checks["self_intersections"].get<size_t>(), c.method.c_str());
-  }
-  if (!c.stats_json.empty()) {
-    nlohmann::json j = surface_stats_json("press", c.input, c.output, vs, mesh);
-    j["method"] = c.method;
-    j["smoothing"] = method_json;
-    j["seconds"] = {{"read", vs.seconds_read}, {"extract", vs.seconds_extract}, {"smooth", seconds_smooth},
-                    {"total", clock.seconds()}};
-    j["peak_memory_bytes"] = peak_rss_bytes();
-    if (c.check) j["checks"] = checks;
-    write_json(c.stats_json, j);
-  }
-}
 
 nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
   nlohmann::json list = nlohmann::json::array();
@@ -163,60 +81,87 @@ void write_features(const std::string& path, const Mesh& mesh) {
 
 void run_press(const PressCmd& c, const Global& g) {
   mesh_format_from_path(c.output);  // a bad extension fails before any work
-  if (c.method != "pressing") return run_other_method(c, g);
-  if (c.params.lambda || c.params.mu) throw UsageError("--lambda and --mu apply to taubin and laplacian only");
+  SurfaceOptions so;
+  so.method = parse_method(c.method);
+  const bool pressing = so.method == Method::pressing;
+  if (!pressing)
+    for (const char* name : {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend",
+                             "--flat-width", "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations",
+                             "--features", "--step", "--arc-length", "--margin", "--levels", "--momentum",
+                             "--weighting", "--plain"})
+      if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
   if (!c.features.empty()) {
     const MeshFormat ff = mesh_format_from_path(c.features);
     if (ff != MeshFormat::ply && ff != MeshFormat::obj) throw UsageError("--features must be a .ply or .obj file");
     if (c.no_flats || c.no_sharpen) throw UsageError("--features needs sharpening (drop --no-flats / --no-sharpen)");
   }
   if (!(c.sharpen.sharp_angle >= 0 && c.sharpen.sharp_angle <= 180)) throw UsageError("--sharp-angle must be in [0, 180]");
-  const PressOptions po = c.smooth.resolve();
+  so.press = c.smooth.resolve();
   if (!(c.flats.min_area >= 0)) throw UsageError("--min-flat-area must be >= 0");
   if (!(c.flats.junction_angle >= 0 && c.flats.junction_angle <= 180)) throw UsageError("--junction-angle must be in [0, 180]");
   if (!(c.flats.tolerance > 0) || !(c.flats.max_bend > 0) || !(c.flats.min_width >= 0))
     throw UsageError("--flat-tolerance and --flat-bend must be > 0, --flat-width >= 0");
+  so.flats = !c.no_flats;
+  so.flat = c.flats;
+  so.sharpen = !c.no_sharpen;
+  so.sharp = c.sharpen;
+  so.color_regions = c.color_regions;
+  if (!pressing) {  // pressing reads these from so.press, with its own defaults
+    if (c.smooth.iterations_option->count()) so.iterations = c.smooth.options.iterations;
+    if (c.smooth.tolerance_option->count()) so.tolerance = c.smooth.options.tolerance;
+  }
+  so.lambda = c.params.lambda;
+  so.mu = c.params.mu;
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
-  VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());
-  StickSurface& surface = vs.surface;
-  PressOptions o = po;
-  o.progress = bar.get();
-  FlatOptions fo = c.flats;
-  fo.progress = bar.get();
-  FlatSegmentation seg;
-  const SliceCurves curves = build_slice_curves(surface);
-  const FeaturePressStats fs = press_with_flats(surface, curves, o, c.no_flats ? nullptr : &fo, &seg);
-  const PressStats& ps = fs.press;
-  Mesh mesh;
-  SharpenStats sharp;
-  if (c.no_flats || c.no_sharpen) {
-    mesh = to_mesh(surface);
-    if (!c.no_flats) add_region_attributes(mesh, seg, c.color_regions);
-  } else {
-    SharpenOptions so = c.sharpen;
-    so.colors = c.color_regions;
-    SharpenResult sr = sharpen(surface, seg, so);
-    mesh = std::move(sr.mesh);
-    sharp = sr.stats;
-  }
-  const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), "pressed") : nlohmann::json();
+  so.progress = bar.get();
+  so.extract.max_bytes = g.memory_limit();
+  const BinaryVolume volume = load_binary(c.input, c.in, g);
+  const double seconds_read = clock.seconds();
+  const SurfaceResult r = smooth_surface(volume, so);
+  const Mesh& mesh = r.mesh;
+  // Methods without the in/out guarantee have their checks reported, not enforced.
+  const bool strict = keeps_classification(so.method);
+  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), c.method, strict) : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
   if (!c.features.empty()) write_features(c.features, mesh);
-  if (!g.quiet)
-    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %zu sharp edges, %d iterations (last max change %.2g)\n",
-                 c.output.c_str(), mesh.vertex_count(), mesh.face_count(), seg.flats.size(), seg.frozen_count(),
-                 size_t(seg.stats.junctions), mesh.edges.size(), ps.iterations, ps.last_max_change);
+  const int iterations = pressing ? r.press.iterations : so.method == Method::cesn ? r.net.iterations : r.smooth.iterations;
+  if (!g.quiet) {
+    if (pressing)
+      std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %zu sharp edges, %d iterations (last max change %.2g)\n",
+                   c.output.c_str(), mesh.vertex_count(), mesh.face_count(), r.flats.flats.size(), r.flats.frozen_count(),
+                   size_t(r.flats.stats.junctions), mesh.edges.size(), iterations, r.press.last_max_change);
+    else
+      std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %s, %d iterations\n", c.output.c_str(), mesh.vertex_count(),
+                   mesh.face_count(), c.method.c_str(), iterations);
+    if (c.check && !strict)
+      std::fprintf(stderr, "%s: %llu samples on the wrong side, %zu self-intersections (%s promises neither)\n",
+                   c.output.c_str(), (unsigned long long)checks["classification_violations"].get<uint64_t>(),
+                   checks["self_intersections"].get<size_t>(), c.method.c_str());
+  }
   if (!c.stats_json.empty()) {
-    nlohmann::json j = surface_stats_json("press", c.input, c.output, vs, mesh);
-    j["method"] = "pressing";
-    j["pressing"] = press_stats_json(ps, po);
-    if (!c.no_flats) j["flats"] = flats_json(seg, fo);
-    if (!c.no_flats && !c.no_sharpen) j["sharpen"] = sharpen_json(sharp, c.sharpen);
-    j["seconds"] = {{"read", vs.seconds_read}, {"extract", vs.seconds_extract}, {"press", ps.seconds},
-                    {"sharpen", sharp.seconds}, {"total", clock.seconds()}};
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, volume, r.extract, mesh);
+    j["method"] = c.method;
+    if (pressing) {
+      j["pressing"] = press_stats_json(r.press, so.press);
+      if (so.flats) j["flats"] = flats_json(r.flats, so.flat);
+      if (so.flats && so.sharpen) j["sharpen"] = sharpen_json(r.sharpen, so.sharp);
+      j["seconds"] = {{"read", seconds_read}, {"extract", r.seconds_extract}, {"press", r.press.seconds},
+                      {"sharpen", r.sharpen.seconds}, {"total", clock.seconds()}};
+    } else {
+      if (so.method == Method::cesn)
+        j["smoothing"] = {{"iterations", r.net.iterations},      {"converged", r.net.converged},
+                          {"last_max_change", r.net.last_max_change}, {"patch_vertices", r.net.patch_vertices},
+                          {"split_cells", r.net.split_cells},    {"face_vertices", r.net.face_vertices},
+                          {"quads", r.net.quads},                {"seconds_build", r.net.seconds_build},
+                          {"seconds_relax", r.net.seconds_relax}};
+      else
+        j["smoothing"] = smooth_stats_json(r.smooth);
+      j["seconds"] = {{"read", seconds_read}, {"extract", r.seconds_extract}, {"smooth", r.seconds_smooth},
+                      {"total", clock.seconds()}};
+    }
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
     write_json(c.stats_json, j);
@@ -232,8 +177,9 @@ void register_press(CLI::App& app, Global& g) {
   cmd->add_option("input", c->input, "Volume file (or folder of TIFF slices)")->required();
   cmd->add_option("-o,--output", c->output, "Output mesh (.ply .obj .stl .off .glb .gltf)")->required();
   c->cmd = cmd;
-  cmd->add_option("--method", c->method, std::string("Smoothing method: ") + kMethods +
-                                             " (see docs/ARCHITECTURE.md; all but pressing are baselines)")
+  cmd->add_option("--method", c->method,
+                  "Smoothing method: pressing, cesn, diamond, cell-edge, cell-size, taubin or laplacian (all but "
+                  "pressing are baselines; docs/ARCHITECTURE.md)")
       ->capture_default_str();
   c->in.bind(*cmd);
   c->smooth.bind(*cmd);

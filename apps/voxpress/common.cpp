@@ -125,13 +125,13 @@ VolumeSurface load_surface(const std::string& path, const InputOptions& in, cons
 }
 
 nlohmann::json surface_stats_json(const char* command, const std::string& input, const std::string& output,
-                                  const VolumeSurface& vs, const Mesh& mesh) {
+                                  const BinaryVolume& volume, const ExtractStats& extract, const Mesh& mesh) {
   nlohmann::json j;
   j["command"] = command;
   j["input"] = input;
   j["output"] = output;
-  j["lattice"] = lattice_json(vs.volume.lattice);
-  j["counts"] = {{"samples", vs.stats.samples}, {"sticks", vs.stats.sticks}, {"vertices", mesh.vertex_count()},
+  j["lattice"] = lattice_json(volume.lattice);
+  j["counts"] = {{"samples", extract.samples}, {"sticks", extract.sticks}, {"vertices", mesh.vertex_count()},
                  {"triangles", mesh.face_count()}};
   return j;
 }
@@ -185,14 +185,6 @@ void MethodParams::bind_fairing(CLI::App& cmd) {
 ConstrainedOptions MethodParams::constrained(MeshConstraint c, Progress* progress) const {
   ConstrainedOptions o;
   o.constraint = c;
-  if (iterations) o.max_iterations = *iterations;
-  if (tolerance) o.threshold = *tolerance;
-  o.progress = progress;
-  return o;
-}
-
-SurfaceNetOptions MethodParams::surface_net(Progress* progress) const {
-  SurfaceNetOptions o;
   if (iterations) o.max_iterations = *iterations;
   if (tolerance) o.threshold = *tolerance;
   o.progress = progress;

@@ -74,7 +74,7 @@ VolumeSurface load_surface(const std::string& path, const InputOptions& in, cons
 /// The --stats-json fields `extract` and `press` share: command, input,
 /// output, lattice and counts.
 nlohmann::json surface_stats_json(const char* command, const std::string& input, const std::string& output,
-                                  const VolumeSurface& vs, const Mesh& mesh);
+                                  const BinaryVolume& volume, const ExtractStats& extract, const Mesh& mesh);
 
 /// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).
 Vec3 parse_vec3(const std::string& text, const std::string& option);
@@ -92,15 +92,14 @@ struct PressCli {
 };
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o);
 
-/// The parameters of the methods other than Pressing (Bade's constraints,
-/// CESN, Taubin, Laplacian); unset ones take each method's default.
+/// The parameters of `smooth-mesh` (Bade's constraints, Taubin, Laplacian);
+/// unset ones take each method's default.
 struct MethodParams {
   std::optional<int> iterations;
   std::optional<double> tolerance, lambda, mu;
   /// Adds --lambda and --mu (Taubin / Laplacian) to a command or group.
   void bind_fairing(CLI::App& cmd);
   ConstrainedOptions constrained(MeshConstraint c, Progress* progress) const;
-  SurfaceNetOptions surface_net(Progress* progress) const;
   FairOptions fairing(FairOptions::Kind kind, Progress* progress) const;
 };
 /// "taubin" or "laplacian" -> its kind; nullopt otherwise.

@@ -18,6 +18,7 @@
 #include "voxpress/smooth/flats.h"
 #include "voxpress/smooth/pressing.h"
 #include "voxpress/smooth/mesh_smoothing.h"
+#include "voxpress/smooth/pipeline.h"
 #include "voxpress/smooth/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
 

@@ -1,0 +1,78 @@
+// voxpress/smooth/pipeline.h — one call from a binary volume to its smooth
+// surface: what `voxpress press` runs (and the Python binding will).
+//
+//   pressing   sticks -> Pressing with flats and junctions -> sharp edges
+//              (each stage optional; the default and the reference method)
+//   cesn       Constrained Elastic Surface Nets from the volume
+//   diamond, cell-edge, cell-size
+//              Bade et al.'s relaxation of the midpoint mesh, lattice known
+//   taubin, laplacian
+//              unconstrained smoothing of the midpoint mesh
+//
+// Only pressing, diamond and cell-edge keep every sample on its side
+// (keeps_classification); all methods give closed, 2-manifold, outward
+// meshes. Deterministic: the same mesh for any thread count.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/progress.h"
+#include "voxpress/core/volume.h"
+#include "voxpress/extract/sticks.h"
+#include "voxpress/smooth/flats.h"
+#include "voxpress/smooth/mesh_smoothing.h"
+#include "voxpress/smooth/pressing.h"
+#include "voxpress/smooth/sharpen.h"
+#include "voxpress/smooth/surface_nets.h"
+
+namespace voxpress {
+
+enum class Method { pressing, cesn, diamond, cell_edge, cell_size, taubin, laplacian };
+/// "pressing", "cesn", "diamond", "cell-edge", "cell-size", "taubin", "laplacian".
+const char* method_name(Method m);
+/// Inverse of method_name; throws UsageError listing the valid names.
+Method parse_method(const std::string& name);
+/// True for the methods that keep every lattice sample on its side.
+bool keeps_classification(Method m);
+
+struct SurfaceOptions {
+  Method method = Method::pressing;
+  // --- pressing
+  PressOptions press;
+  bool flats = true;         ///< find flats and junctions (Section 3)
+  FlatOptions flat;
+  bool sharpen = true;       ///< insert the sharp edges (Section 5; needs flats)
+  SharpenOptions sharp;
+  bool color_regions = false;  ///< vertex colours per region
+  // --- every method: when set, the iteration cap and the stopping tolerance
+  // (pressing: press.iterations / press.tolerance; the others: their
+  // ConstrainedOptions, SurfaceNetOptions or fair_defaults); lambda and mu
+  // for taubin and laplacian only (UsageError otherwise)
+  std::optional<int> iterations;
+  std::optional<double> tolerance, lambda, mu;
+  // --- all
+  ExtractOptions extract;
+  Progress* progress = nullptr;  ///< overrides the stages' own progress pointers
+};
+
+struct SurfaceResult {
+  Mesh mesh;                   ///< physical units, outward triangles
+  ExtractStats extract;
+  // pressing
+  PressStats press;
+  FlatSegmentation flats;      ///< empty without flats
+  SharpenStats sharpen;
+  // the other methods
+  SmoothStats smooth;          ///< diamond, cell-edge, cell-size, taubin, laplacian
+  SurfaceNetStats net;         ///< cesn
+  double seconds_extract = 0, seconds_smooth = 0;
+};
+
+/// The volume's smooth surface by `options.method`. Throws InputError for an
+/// empty or full volume, UsageError for invalid options, LimitError when
+/// options.extract.max_bytes would be exceeded.
+SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& options = {});
+
+}  // namespace voxpress
