@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # scripts/setup.sh [--tests] — installs what voxpress needs on Debian 12 (only
-# the packages that are missing) and builds it in Release under build/.
+# the packages that are missing) and builds it in Release under build/
+# (library, CLI, benchmarks, tests and the Python module in build/python).
 # --tests also installs the Node packages the test suite uses (npm ci).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -10,8 +11,9 @@ with_tests=0
 packages=(build-essential cmake ninja-build pkg-config
           libeigen3-dev libtbb-dev zlib1g-dev libtiff-dev libpng-dev libnifti2-dev
           libtinygltf-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
-          libgtest-dev libgmock-dev libbenchmark-dev)
-[ $with_tests = 1 ] && packages+=(nodejs)
+          libgtest-dev libgmock-dev libbenchmark-dev
+          python3-dev pybind11-dev python3-numpy)
+[ $with_tests = 1 ] && packages+=(nodejs python3-pytest python3-nibabel)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,97 @@
+"""Type stubs for voxpress (the C++ extension voxpress._voxpress)."""
+from typing import Any, Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class Error(RuntimeError): ...
+class InputError(Error):
+    """Bad input data: "<source>: <problem>" (exit code 1 in the CLI)."""
+class LimitError(InputError):
+    """A resource limit would be exceeded (checked before allocating)."""
+class UsageError(Error):
+    """Invalid or contradictory arguments (exit code 2 in the CLI)."""
+
+Method = Literal["pressing", "cesn", "diamond", "cell-edge", "cell-size", "taubin", "laplacian"]
+
+class Lattice:
+    """physical = origin + direction @ diag(spacing) @ (i, j, k)."""
+    @property
+    def dims(self) -> Tuple[int, int, int]: ...
+    @property
+    def spacing(self) -> Tuple[float, float, float]: ...
+    @property
+    def origin(self) -> Tuple[float, float, float]: ...
+    @property
+    def direction(self) -> npt.NDArray[np.float64]:
+        """3 x 3; column a is the physical direction of index axis a."""
+    @property
+    def space(self) -> str:
+        """"LPS", "RAS" or "unknown"."""
+
+class Mesh:
+    """A triangle mesh in physical units, triangles counter-clockwise seen from outside."""
+    @property
+    def vertices(self) -> npt.NDArray[np.float64]:
+        """N x 3 view of the positions (no copy; valid while the Mesh lives)."""
+    @property
+    def faces(self) -> npt.NDArray[np.int32]:
+        """M x 3 vertex indices."""
+    @property
+    def regions(self) -> Optional[npt.NDArray[np.int32]]:
+        """Per face: flat id, -1 for curved faces; None when flats were not searched."""
+    @property
+    def sharp_edges(self) -> npt.NDArray[np.int32]:
+        """K x 2 vertex pairs: the sharp feature curves."""
+    @property
+    def stats(self) -> dict[str, Any]:
+        """method, sticks, vertices, triangles, iterations, flats, sharp_edges, keeps_classification, seconds_*."""
+    def save(self, path: str, ascii: bool = False) -> None:
+        """Writes .ply .obj .stl .off .glb .gltf atomically (no partial file on failure)."""
+
+def press(
+    mask: npt.ArrayLike,
+    *,
+    spacing: Sequence[float] = (1.0, 1.0, 1.0),
+    origin: Sequence[float] = (0.0, 0.0, 0.0),
+    direction: Optional[npt.ArrayLike] = None,
+    method: Method = "pressing",
+    axes: Literal["xyz", "zyx"] = "xyz",
+    label: Optional[Union[int, str]] = None,
+    threshold: Optional[float] = None,
+    iterations: int = ...,
+    tolerance: float = ...,
+    flats: bool = True,
+    sharpen: bool = True,
+    min_flat_area: float = 100,
+    junction_angle: float = 30,
+    sharp_angle: float = 30,
+    color_regions: bool = False,
+    lambda_: float = ...,
+    mu: float = ...,
+) -> Mesh:
+    """The smooth surface of a 3-D mask, as `voxpress press` computes it.
+
+    mask: bool, integer-label or float array; C or Fortran order. axes="xyz"
+    indexes it mask[i, j, k] (nibabel); "zyx" mask[k, j, i]
+    (SimpleITK.GetArrayFromImage). Inside samples: a mask with one non-zero
+    value needs nothing; label maps need label=N (or "all-nonzero"), grey
+    images threshold=T (value >= T). direction: 3 x 3, column a = physical
+    direction of index axis a. The GIL is released while it works.
+    """
+
+def read_volume(path: str) -> Tuple[npt.NDArray[Any], Lattice]:
+    """A volume file (NRRD, NIfTI, MetaImage, TIFF) as an array indexed [i, j, k] (no copy) and its lattice."""
+
+def read_mesh(path: str) -> Mesh:
+    """A .ply .obj .stl .off mesh (STL welded)."""
+
+def check(mesh: Mesh, volume: Union[str, npt.ArrayLike, None] = None, **lattice: Any) -> dict[str, Any]:
+    """check_mesh (closed, manifold, oriented, self-intersections); with a volume (path, or a mask with
+    spacing/origin/direction/axes/label/threshold keywords) also the samples on the wrong side."""
+
+def evaluate(mesh: Mesh, *, truth: str = "", volume: Union[str, npt.ArrayLike, None] = None,
+             samples: int = 200000) -> dict[str, Any]:
+    """Distances to the true surface, as `voxpress eval` (truth: a mesh file or a volume that remembers its model)."""

@@ -1,0 +1,382 @@
+// The voxpress Python module (pybind11): numpy masks in, meshes out, over
+// the same library calls as the CLI (smooth_surface, read_volume, check_*,
+// evaluate), so results and error messages are the CLI's. The GIL is
+// released while the library works.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cstring>
+
+#include "voxpress/eval/metrics.h"
+#include "voxpress/eval/truth.h"
+#include "voxpress/voxpress.h"
+
+namespace py = pybind11;
+using namespace voxpress;
+
+namespace {
+
+// A mesh and the statistics of the call that made it.
+struct PyMesh {
+  Mesh mesh;
+  py::dict stats;
+};
+
+ScalarType scalar_type(const py::dtype& d) {
+  const char kind = d.kind();
+  const size_t size = size_t(d.itemsize());
+  if (kind == 'b') return ScalarType::u8;
+  if (kind == 'u') {
+    if (size == 1) return ScalarType::u8;
+    if (size == 2) return ScalarType::u16;
+    if (size == 4) return ScalarType::u32;
+    if (size == 8) return ScalarType::u64;
+  }
+  if (kind == 'i') {
+    if (size == 1) return ScalarType::i8;
+    if (size == 2) return ScalarType::i16;
+    if (size == 4) return ScalarType::i32;
+    if (size == 8) return ScalarType::i64;
+  }
+  if (kind == 'f') {
+    if (size == 4) return ScalarType::f32;
+    if (size == 8) return ScalarType::f64;
+  }
+  throw UsageError("mask dtype " + std::string(py::str(static_cast<const py::handle&>(d))) + " is not supported (bool, integer or float32/64)");
+}
+
+Vec3 vec3(const py::object& o, const char* what) {
+  const auto v = o.cast<std::vector<double>>();
+  if (v.size() != 3) throw UsageError(std::string(what) + " must have 3 values");
+  return {v[0], v[1], v[2]};
+}
+
+// The array as a ScalarVolume on its lattice: x fastest, whatever its
+// memory order. axes "xyz": a[i, j, k]; "zyx": a[k, j, i] (SimpleITK).
+ScalarVolume to_volume(const py::array& a, const py::object& spacing, const py::object& origin,
+                       const py::object& direction, const std::string& axes) {
+  if (a.ndim() != 3) throw UsageError("the mask must be a 3-D array (got " + std::to_string(a.ndim()) + " dimensions)");
+  if (axes != "xyz" && axes != "zyx") throw UsageError("axes must be 'xyz' or 'zyx' (got '" + axes + "')");
+  ScalarVolume v;
+  v.type = scalar_type(a.dtype());
+  v.source = "array";
+  const bool zyx = axes == "zyx";
+  std::array<py::ssize_t, 3> stride{};
+  for (int d = 0; d < 3; ++d) {
+    const int src = zyx ? 2 - d : d;
+    v.lattice.dims[size_t(d)] = int64_t(a.shape(src));
+    stride[size_t(d)] = a.strides(src);
+  }
+  v.lattice.spacing = vec3(spacing, "spacing");
+  v.lattice.origin = vec3(origin, "origin");
+  if (!direction.is_none()) {
+    const auto m = direction.cast<std::vector<std::vector<double>>>();
+    if (m.size() != 3 || m[0].size() != 3 || m[1].size() != 3 || m[2].size() != 3)
+      throw UsageError("direction must be a 3x3 matrix (columns: the physical directions of the array axes)");
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) v.lattice.direction(r, c) = m[size_t(r)][size_t(c)];
+  }
+  v.lattice.validate();
+  const size_t item = size_t(a.itemsize());
+  v.bytes.resize(size_t(v.lattice.size()) * item);
+  const auto* src = static_cast<const std::byte*>(a.data());
+  const int64_t nx = v.lattice.dims[0], ny = v.lattice.dims[1], nz = v.lattice.dims[2];
+  std::byte* out = v.bytes.data();
+  if (stride[0] == py::ssize_t(item) && stride[1] == py::ssize_t(item) * nx && stride[2] == py::ssize_t(item) * nx * ny) {
+    std::memcpy(out, src, v.bytes.size());  // already x fastest and contiguous (Fortran order, or zyx C order)
+  } else {
+    // Gather in x-fastest order, a z slab per task (typed copies: no per-element memcpy).
+    auto gather = [&](auto tag) {
+      using T = decltype(tag);
+      T* dst = reinterpret_cast<T*>(out);
+      tbb::parallel_for(int64_t(0), nz, [&](int64_t k) {
+        T* row = dst + k * nx * ny;
+        for (int64_t j = 0; j < ny; ++j, row += nx) {
+          const std::byte* p = src + j * stride[1] + k * stride[2];
+          for (int64_t i = 0; i < nx; ++i) std::memcpy(row + i, p + i * stride[0], sizeof(T));
+        }
+      });
+    };
+    switch (item) {
+      case 1: gather(uint8_t{}); break;
+      case 2: gather(uint16_t{}); break;
+      case 4: gather(uint32_t{}); break;
+      default: gather(uint64_t{}); break;
+    }
+  }
+  return v;
+}
+
+Selection selection(const py::object& label, const py::object& threshold) {
+  if (!label.is_none() && !threshold.is_none()) throw UsageError("choose one of label and threshold");
+  Selection s;
+  if (!label.is_none()) s = parse_label_selection(py::str(label));
+  if (!threshold.is_none()) {
+    s.kind = Selection::Kind::threshold;
+    s.value = threshold.cast<double>();
+  }
+  return s;
+}
+
+py::array_t<int32_t> int_rows(const std::vector<std::array<uint32_t, 3>>& rows) {
+  py::array_t<int32_t> a({py::ssize_t(rows.size()), py::ssize_t(3)});
+  auto m = a.mutable_unchecked<2>();
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (int c = 0; c < 3; ++c) m(py::ssize_t(r), c) = int32_t(rows[r][size_t(c)]);
+  return a;
+}
+
+void set_options(SurfaceOptions& o, const py::kwargs& kw) {
+  for (const auto& [key, value] : kw) {
+    const std::string k = py::str(key);
+    if (k == "iterations") o.iterations = value.cast<int>();
+    else if (k == "tolerance") o.tolerance = value.cast<double>();
+    else if (k == "flats") o.flats = value.cast<bool>();
+    else if (k == "sharpen") o.sharpen = value.cast<bool>();
+    else if (k == "min_flat_area") o.flat.min_area = value.cast<double>();
+    else if (k == "junction_angle") o.flat.junction_angle = value.cast<double>();
+    else if (k == "sharp_angle") o.sharp.sharp_angle = value.cast<double>();
+    else if (k == "color_regions") o.color_regions = value.cast<bool>();
+    else if (k == "lambda_") o.lambda = value.cast<double>();
+    else if (k == "mu") o.mu = value.cast<double>();
+    else
+      throw py::type_error("press() got an unknown option '" + k +
+                           "' (iterations, tolerance, flats, sharpen, min_flat_area, junction_angle, sharp_angle, "
+                           "color_regions, lambda_, mu)");
+  }
+}
+
+PyMesh py_press(const py::array& mask, const py::object& spacing, const py::object& origin, const py::object& direction,
+             const std::string& method, const std::string& axes, const py::object& label, const py::object& threshold,
+             const py::kwargs& kw) {
+  SurfaceOptions o;
+  o.method = parse_method(method);
+  set_options(o, kw);
+  const Selection sel = selection(label, threshold);
+  ScalarVolume scalar = to_volume(mask, spacing, origin, direction, axes);
+  SurfaceResult r;
+  double seconds_binarize = 0;
+  {
+    py::gil_scoped_release release;
+    const auto t0 = std::chrono::steady_clock::now();
+    const BinaryVolume volume = binarize(scalar, sel);
+    seconds_binarize = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    scalar = {};
+    r = smooth_surface(volume, o);
+  }
+  PyMesh out;
+  out.mesh = std::move(r.mesh);
+  const bool pressing = o.method == Method::pressing;
+  out.stats["method"] = method;
+  out.stats["sticks"] = r.extract.sticks;
+  out.stats["vertices"] = out.mesh.vertex_count();
+  out.stats["triangles"] = out.mesh.face_count();
+  out.stats["iterations"] = pressing ? r.press.iterations : o.method == Method::cesn ? r.net.iterations : r.smooth.iterations;
+  out.stats["flats"] = r.flats.flats.size();
+  out.stats["sharp_edges"] = out.mesh.edges.size();
+  out.stats["keeps_classification"] = keeps_classification(o.method);
+  out.stats["seconds_binarize"] = seconds_binarize;
+  out.stats["seconds_extract"] = r.seconds_extract;
+  out.stats["seconds_smooth"] = r.seconds_smooth;
+  return out;
+}
+
+// A volume argument of check/evaluate: a file path, or a mask array on a lattice.
+BinaryVolume binary_argument(const py::object& volume, const py::dict& lattice, ScalarVolume* scalar_out) {
+  const py::object none = py::none();
+  auto get = [&](const char* k, py::object d) { return lattice.contains(k) ? py::object(lattice[k]) : d; };
+  ScalarVolume s = py::isinstance<py::array>(volume)
+                       ? to_volume(volume.cast<py::array>(), get("spacing", py::make_tuple(1, 1, 1)),
+                                   get("origin", py::make_tuple(0, 0, 0)), get("direction", none),
+                                   get("axes", py::str("xyz")).cast<std::string>())
+                       : read_volume(volume.cast<std::string>());
+  BinaryVolume b = binarize(s, selection(get("label", none), get("threshold", none)));
+  if (scalar_out) *scalar_out = std::move(s);
+  return b;
+}
+
+py::dict py_check(const PyMesh& m, const py::object& volume, const py::kwargs& kw) {
+  py::dict lattice(kw);
+  std::optional<BinaryVolume> b;
+  if (!volume.is_none()) b = binary_argument(volume, lattice, nullptr);
+  MeshCheck c;
+  std::optional<ClassificationReport> cr;
+  {
+    py::gil_scoped_release release;
+    c = check_mesh(m.mesh);
+    if (b) cr = check_classification(m.mesh, *b);
+  }
+  py::dict d;
+  d["ok"] = c.ok() && (!cr || cr->violations == 0);
+  d["closed"] = c.closed();
+  d["manifold"] = c.manifold();
+  d["oriented"] = c.oriented();
+  d["degenerate_faces"] = c.degenerate_faces;
+  d["self_intersections"] = c.self_intersections;
+  d["components"] = c.components;
+  d["euler"] = c.euler;
+  d["volume"] = c.signed_volume;
+  d["area"] = c.area;
+  d["problems"] = c.problems;
+  if (cr) {
+    d["samples"] = cr->samples;
+    d["classification_violations"] = cr->violations;
+  }
+  return d;
+}
+
+py::dict py_evaluate(const PyMesh& m, const std::string& truth, const py::object& volume, size_t samples) {
+  ScalarVolume scalar;
+  std::optional<BinaryVolume> b;
+  if (!volume.is_none()) b = binary_argument(volume, py::dict(), &scalar);
+  EvalReport e;
+  {
+    py::gil_scoped_release release;
+    const auto t = resolve_truth(truth, b ? &scalar : nullptr);
+    EvalOptions o;
+    o.samples = samples;
+    if (b) o.volume = &*b;
+    e = voxpress::evaluate(m.mesh, *t, o);
+  }
+  auto distances = [](const DistanceStats& s) {
+    py::dict d;
+    d["rms"] = s.rms;
+    d["mean"] = s.mean;
+    d["max"] = s.max;
+    return d;
+  };
+  py::dict d;
+  d["truth"] = e.truth;
+  d["result_to_truth"] = distances(e.result_to_truth);
+  d["truth_to_result"] = distances(e.truth_to_result);
+  d["hausdorff"] = e.hausdorff;
+  d["normal_error_deg"] = e.normal_error_deg;
+  d["volume_ratio"] = e.volume_ratio;
+  if (b) {
+    d["result_to_truth_vox"] = distances(e.result_to_truth_vox);
+    d["truth_to_result_vox"] = distances(e.truth_to_result_vox);
+    d["classification_violations"] = e.classification_violations.value_or(0);
+    d["stick_rms_vox"] = e.stick_rms_vox ? py::object(py::float_(*e.stick_rms_vox)) : py::object(py::none());
+  }
+  if (e.sharp_edge_hausdorff) d["sharp_edge_hausdorff"] = *e.sharp_edge_hausdorff;
+  d["mesh_ok"] = e.mesh.ok();
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_voxpress, m) {
+  m.doc() = "voxpress: smooth, accurate solids from binary voxel volumes (C++ core).";
+  m.attr("__version__") = kVersion;
+
+  static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
+  static py::exception<InputError> input_error(m, "InputError", error.ptr());
+  static py::exception<UsageError> usage_error(m, "UsageError", error.ptr());
+  static py::exception<LimitError> limit_error(m, "LimitError", input_error.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const LimitError& e) {
+      limit_error(e.what());
+    } catch (const InputError& e) {
+      input_error(e.what());
+    } catch (const UsageError& e) {
+      usage_error(e.what());
+    } catch (const Error& e) {
+      error(e.what());
+    }
+  });
+
+  py::class_<Lattice>(m, "Lattice", "The sampling grid: physical = origin + direction @ diag(spacing) @ (i, j, k).")
+      .def_property_readonly("dims", [](const Lattice& l) { return py::make_tuple(l.dims[0], l.dims[1], l.dims[2]); })
+      .def_property_readonly("spacing", [](const Lattice& l) { return py::make_tuple(l.spacing.x(), l.spacing.y(), l.spacing.z()); })
+      .def_property_readonly("origin", [](const Lattice& l) { return py::make_tuple(l.origin.x(), l.origin.y(), l.origin.z()); })
+      .def_property_readonly("direction", [](const Lattice& l) {
+        py::array_t<double> d({3, 3});
+        auto w = d.mutable_unchecked<2>();
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) w(r, c) = l.direction(r, c);
+        return d;
+      }, "3x3 array; column a is the physical direction of index axis a")
+      .def_property_readonly("space", [](const Lattice& l) { return std::string(space_name(l.space)); })
+      .def("__repr__", [](const Lattice& l) {
+        return "Lattice(dims=(" + std::to_string(l.dims[0]) + ", " + std::to_string(l.dims[1]) + ", " +
+               std::to_string(l.dims[2]) + "), spacing=(" + std::to_string(l.spacing.x()) + ", " +
+               std::to_string(l.spacing.y()) + ", " + std::to_string(l.spacing.z()) + "))";
+      });
+
+  py::class_<PyMesh>(m, "Mesh", "A triangle mesh in physical units, triangles counter-clockwise seen from outside.")
+      .def_property_readonly("vertices", [](py::object self) {
+        PyMesh& pm = self.cast<PyMesh&>();
+        return py::array_t<double>({py::ssize_t(pm.mesh.vertex_count()), py::ssize_t(3)},
+                                   {py::ssize_t(sizeof(Vec3)), py::ssize_t(sizeof(double))},
+                                   pm.mesh.positions.empty() ? nullptr : pm.mesh.positions[0].data(), self);
+      }, "N x 3 float64 view of the positions (no copy)")
+      .def_property_readonly("faces", [](const PyMesh& pm) { return int_rows(pm.mesh.triangles); }, "M x 3 int32")
+      .def_property_readonly("regions", [](const PyMesh& pm) -> py::object {
+        const MeshAttribute* a = pm.mesh.face_attribute("region");
+        if (!a) return py::none();
+        py::array_t<int32_t> r(py::ssize_t(a->values.size()));
+        for (size_t i = 0; i < a->values.size(); ++i) r.mutable_at(py::ssize_t(i)) = int32_t(a->values[i]);
+        return r;
+      }, "per face: flat id, -1 curved (None without flats)")
+      .def_property_readonly("sharp_edges", [](const PyMesh& pm) {
+        py::array_t<int32_t> a({py::ssize_t(pm.mesh.edges.size()), py::ssize_t(2)});
+        auto w = a.mutable_unchecked<2>();
+        for (size_t i = 0; i < pm.mesh.edges.size(); ++i)
+          for (int c = 0; c < 2; ++c) w(py::ssize_t(i), c) = int32_t(pm.mesh.edges[i][size_t(c)]);
+        return a;
+      }, "K x 2 int32 vertex pairs of the sharp feature curves")
+      .def_readonly("stats", &PyMesh::stats, "what the call did: method, counts, iterations, seconds")
+      .def("save", [](const PyMesh& pm, const std::string& path, bool ascii) {
+        MeshWriteOptions o;
+        o.ascii = ascii;
+        py::gil_scoped_release release;
+        write_mesh(path, pm.mesh, o);
+      }, py::arg("path"), py::arg("ascii") = false, "Writes .ply .obj .stl .off .glb .gltf (atomically)")
+      .def("__repr__", [](const PyMesh& pm) {
+        return "Mesh(" + std::to_string(pm.mesh.vertex_count()) + " vertices, " + std::to_string(pm.mesh.face_count()) +
+               " triangles)";
+      });
+
+  m.def("press", &py_press, py::arg("mask"), py::kw_only(), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
+        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(),
+        py::arg("method") = "pressing", py::arg("axes") = "xyz", py::arg("label") = py::none(),
+        py::arg("threshold") = py::none(),
+        "The smooth surface of a mask (see voxpress/__init__.pyi).");
+  m.def("read_volume", [](const std::string& path) {
+        ScalarVolume* v = nullptr;
+        {
+          py::gil_scoped_release release;
+          v = new ScalarVolume(read_volume(path));
+        }
+        py::capsule owner(v, [](void* p) { delete static_cast<ScalarVolume*>(p); });
+        const size_t item = scalar_size(v->type);
+        static const char* kFormat[] = {"B", "b", "H", "h", "I", "i", "Q", "q", "f", "d"};
+        const auto& d = v->lattice.dims;
+        std::vector<py::ssize_t> shape{d[0], d[1], d[2]};
+        std::vector<py::ssize_t> strides{py::ssize_t(item), py::ssize_t(item) * d[0], py::ssize_t(item) * d[0] * d[1]};
+        if (v->components > 1) {
+          shape.push_back(v->components);
+          for (auto& s : strides) s *= v->components;
+          strides.push_back(py::ssize_t(item));
+        }
+        const py::dtype dt(kFormat[size_t(v->type)]);
+        py::array a(dt, shape, strides, v->bytes.data(), owner);
+        return py::make_tuple(a, v->lattice);
+      }, py::arg("path"), "(array indexed [i, j, k] without copying, Lattice)");
+  m.def("read_mesh", [](const std::string& path) {
+        PyMesh pm;
+        py::gil_scoped_release release;
+        pm.mesh = read_mesh(path);
+        return pm;
+      }, py::arg("path"), "Reads .ply .obj .stl .off");
+  m.def("check", &py_check, py::arg("mesh"), py::arg("volume") = py::none(),
+        "Closed, manifold, oriented, self-intersections; with a volume, every sample on its side.");
+  m.def("evaluate", &py_evaluate, py::arg("mesh"), py::kw_only(), py::arg("truth") = "", py::arg("volume") = py::none(),
+        py::arg("samples") = 200000, "Distances to the true surface (as `voxpress eval`).");
+}

@@ -1,0 +1,133 @@
+"""The Python module against the CLI, nibabel and its own promises.
+
+Run by ctest (tests/CMakeLists.txt) with PYTHONPATH=build/python and
+VOXPRESS_CLI set to the command-line tool.
+"""
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import voxpress
+
+CLI = os.environ.get("VOXPRESS_CLI", "voxpress")
+
+
+def cli(*args):
+    subprocess.run([CLI, "-q", *map(str, args)], check=True, capture_output=True)
+
+
+def ball(n=24, r=8.5):
+    i, j, k = np.indices((n, n, n))
+    return (i - n / 2 + 0.3) ** 2 + (j - n / 2) ** 2 + (k - n / 2 - 0.2) ** 2 < r * r
+
+
+@pytest.mark.parametrize("method", ["pressing", "cesn", "diamond", "taubin"])
+def test_same_mesh_as_the_cli(tmp_path, method):
+    vol = tmp_path / "part.nrrd"
+    cli("generate", "cad-part", "--res", 40, "--rotate", "random:3", "--spacing", "1,0.9,1.3", "-o", vol)
+    cli("press", vol, "-o", tmp_path / "cli.ply", "--method", method)
+    data, lattice = voxpress.read_volume(str(vol))
+    assert data.shape == lattice.dims
+    mesh = voxpress.press(data, spacing=lattice.spacing, origin=lattice.origin, direction=lattice.direction,
+                          method=method)
+    ref = voxpress.read_mesh(str(tmp_path / "cli.ply"))
+    np.testing.assert_array_equal(mesh.faces, ref.faces)
+    np.testing.assert_array_equal(mesh.vertices, ref.vertices)  # PLY keeps doubles exactly
+    assert mesh.stats["method"] == method
+
+
+def test_axes_order_and_spacing_match_a_nifti_read_with_nibabel(tmp_path):
+    nib = pytest.importorskip("nibabel")
+    vol = tmp_path / "t.nii.gz"
+    cli("generate", "torus", "--res", 36, "--rotate", "random:2", "--spacing", "0.8,1.1,1.7", "-o", vol)
+    cli("press", vol, "-o", tmp_path / "cli.ply")
+    img = nib.load(str(vol))
+    data = np.asanyarray(img.dataobj)
+    zooms = np.array(img.header.get_zooms()[:3], float)
+    affine = img.affine
+    kw = dict(spacing=zooms, origin=affine[:3, 3], direction=affine[:3, :3] / zooms)
+    ref = voxpress.read_mesh(str(tmp_path / "cli.ply"))
+    for mask, axes in [(data, "xyz"),                                         # nibabel: [i, j, k], Fortran order
+                       (np.ascontiguousarray(data.transpose(2, 1, 0)), "zyx"),  # SimpleITK's order
+                       (np.ascontiguousarray(data), "xyz")]:                   # C order
+        mesh = voxpress.press(mask, axes=axes, **kw)
+        np.testing.assert_array_equal(mesh.faces, ref.faces)
+        np.testing.assert_allclose(mesh.vertices, ref.vertices, rtol=0, atol=1e-9)
+    lo, hi = ref.vertices.min(0), ref.vertices.max(0)
+    assert np.all(hi - lo > 10)  # in millimetres, not voxels
+
+
+def test_labels_dtypes_and_the_guarantee():
+    m = ball()
+    labels = m.astype(np.int16) * 3
+    labels[:4] = 7  # a second label
+    with pytest.raises(voxpress.InputError, match="--label"):
+        voxpress.press(labels)
+    by_label = voxpress.press(labels, label=3)
+    assert by_label.stats["vertices"] == voxpress.press(m.astype(np.uint8)).stats["vertices"]
+    grey = m.astype(np.float32) * 100
+    assert voxpress.press(grey, threshold=50).stats["sticks"] == by_label.stats["sticks"]
+    for method in ["pressing", "diamond", "cell-edge"]:
+        mesh = voxpress.press(m, method=method, spacing=(0.5, 0.5, 2.0))
+        report = voxpress.check(mesh, m, spacing=(0.5, 0.5, 2.0))
+        assert report["closed"] and report["manifold"] and report["oriented"]
+        assert report["classification_violations"] == 0, method
+
+
+def test_bad_arguments_raise_clear_exceptions():
+    m = ball()
+    with pytest.raises(voxpress.UsageError, match="unknown method 'blur'"):
+        voxpress.press(m, method="blur")
+    with pytest.raises(voxpress.UsageError, match="3-D"):
+        voxpress.press(np.zeros((4, 4), bool))
+    with pytest.raises(voxpress.UsageError, match="axes"):
+        voxpress.press(m, axes="xzy")
+    with pytest.raises(voxpress.UsageError):
+        voxpress.press(m, spacing=(1, -1, 1))
+    with pytest.raises(voxpress.InputError, match="empty"):
+        voxpress.press(np.zeros((5, 5, 5), bool))
+    with pytest.raises(TypeError, match="unknown option 'smoothness'"):
+        voxpress.press(m, smoothness=3)
+    with pytest.raises(voxpress.UsageError, match="lambda"):
+        voxpress.press(m, method="diamond", lambda_=0.3)
+    with pytest.raises(voxpress.InputError, match="no such file"):
+        voxpress.read_volume("/nonexistent/x.nrrd")
+    assert issubclass(voxpress.LimitError, voxpress.InputError)
+    assert issubclass(voxpress.InputError, voxpress.Error)
+
+
+def test_mesh_outputs_and_evaluation(tmp_path):
+    vol = tmp_path / "box.nrrd"
+    cli("generate", "box", "--res", 48, "--rotate", "random:2", "-o", vol)
+    data, lat = voxpress.read_volume(str(vol))
+    mesh = voxpress.press(data, spacing=lat.spacing, origin=lat.origin, direction=lat.direction)
+    assert mesh.regions is not None and mesh.regions.shape == (len(mesh.faces),)
+    assert mesh.regions.max() >= 5  # six flats
+    assert mesh.sharp_edges.shape[1] == 2 and len(mesh.sharp_edges) > 0
+    mesh.save(str(tmp_path / "m.obj"))
+    assert voxpress.read_mesh(str(tmp_path / "m.obj")).faces.shape == mesh.faces.shape
+    e = voxpress.evaluate(mesh, volume=str(vol), samples=20000)
+    m0 = voxpress.evaluate(voxpress.press(data, spacing=lat.spacing, origin=lat.origin, direction=lat.direction,
+                                          method="taubin", iterations=0), volume=str(vol), samples=20000)
+    assert e["classification_violations"] == 0
+    assert e["result_to_truth_vox"]["rms"] < 0.5 * m0["result_to_truth_vox"]["rms"]
+
+
+def rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def test_no_memory_growth_over_1000_calls():
+    m = ball(16, 5.5)
+    for _ in range(100):  # warm up allocator pools
+        voxpress.press(m, method="diamond").vertices.sum()
+    before = rss_bytes()
+    for _ in range(1000):
+        mesh = voxpress.press(m, method="diamond")
+        mesh.vertices.sum()
+        mesh.faces.sum()
+    growth = rss_bytes() - before
+    assert growth < 4 << 20, f"RSS grew by {growth} bytes over 1000 calls"
