@@ -76,6 +76,16 @@ def test_labels_dtypes_and_the_guarantee():
         assert report["classification_violations"] == 0, method
 
 
+def test_strided_views_read_like_their_copies():
+    big = np.zeros((30, 60, 28), np.uint16)
+    big[:24, :48:2, :24] = ball(24)[:, :24, :] * 9
+    for view in [big[:24, :48:2, :24], big[::-1, ::2, :], np.asfortranarray(big)[:, ::2, ::-1]]:
+        a = voxpress.press(view, method="diamond", label=9)
+        b = voxpress.press(np.ascontiguousarray(view), method="diamond", label=9)
+        np.testing.assert_array_equal(a.vertices, b.vertices)
+        np.testing.assert_array_equal(a.faces, b.faces)
+
+
 def test_bad_arguments_raise_clear_exceptions():
     m = ball()
     with pytest.raises(voxpress.UsageError, match="unknown method 'blur'"):
