@@ -78,7 +78,10 @@ def press(
     indexes it mask[i, j, k] (nibabel); "zyx" mask[k, j, i]
     (SimpleITK.GetArrayFromImage). Inside samples: a mask with one non-zero
     value needs nothing; label maps need label=N (or "all-nonzero"), grey
-    images threshold=T (value >= T). direction: 3 x 3, column a = physical
+    images threshold=T (value >= T). spacing, origin and direction always
+    refer to the x, y, z (i, j, k) axes, whatever `axes` says — pass
+    SimpleITK's GetSpacing(), GetOrigin() and GetDirection() (reshaped 3 x 3)
+    unchanged with axes="zyx". direction: 3 x 3, column a = physical
     direction of index axis a. The GIL is released while it works.
     """
 
