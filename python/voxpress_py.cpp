@@ -206,6 +206,12 @@ BinaryVolume binary_argument(const py::object& volume, const py::dict& lattice, 
 }
 
 py::dict py_check(const PyMesh& m, const py::object& volume, const py::kwargs& kw) {
+  for (const auto& item : kw) {
+    const std::string k = py::str(item.first);
+    if (k != "spacing" && k != "origin" && k != "direction" && k != "axes" && k != "label" && k != "threshold")
+      throw py::type_error("check() got an unknown option '" + k +
+                           "' (spacing, origin, direction, axes, label, threshold)");
+  }
   py::dict lattice(kw);
   std::optional<BinaryVolume> b;
   if (!volume.is_none()) b = binary_argument(volume, lattice, nullptr);

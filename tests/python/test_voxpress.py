@@ -102,6 +102,8 @@ def test_bad_arguments_raise_clear_exceptions():
         voxpress.press(m, smoothness=3)
     with pytest.raises(voxpress.UsageError, match="lambda"):
         voxpress.press(m, method="diamond", lambda_=0.3)
+    with pytest.raises(TypeError, match="unknown option 'spacng'"):
+        voxpress.check(voxpress.press(m), m, spacng=(1, 1, 1))
     with pytest.raises(voxpress.InputError, match="no such file"):
         voxpress.read_volume("/nonexistent/x.nrrd")
     assert issubclass(voxpress.LimitError, voxpress.InputError)
