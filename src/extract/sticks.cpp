@@ -29,10 +29,14 @@
 #include <limits>
 #include <numeric>
 
+#include "core/timing.h"
 #include "voxpress/core/error.h"
 #include "voxpress/extract/cube_cases.h"
 
 namespace voxpress {
+
+using detail::seconds_since;
+
 namespace {
 
 struct RowInfo {
@@ -107,10 +111,6 @@ void parallel_rows(int64_t rows, F&& f) {
   tbb::parallel_for(tbb::blocked_range<int64_t>(0, rows, 16), [&](const tbb::blocked_range<int64_t>& range) {
     for (int64_t row = range.begin(); row < range.end(); ++row) f(row);
   });
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 std::vector<RowInfo> classify_rows(const Padded& pv, ProgressCounter* progress) {

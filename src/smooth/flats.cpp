@@ -5,6 +5,7 @@
 // user thresholds are taken in the physical frame.
 #include "voxpress/smooth/flats.h"
 
+#include "core/timing.h"
 #include "surface_graph.h"
 
 #include <tbb/blocked_range.h>
@@ -22,16 +23,15 @@
 #include <queue>
 
 namespace voxpress {
+
+using detail::seconds_since;
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr int kCube = 64;  // cube-map cells per face side: ~1.4 degrees
 constexpr int kNormalRings = 3;  // smoothing rounds of the estimated normals
 constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // ---------------------------------------------------------------- directions
 // Equal-angle cube map: face (axis a, sign), the two other coordinates

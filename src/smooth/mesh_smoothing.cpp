@@ -11,15 +11,15 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/timing.h"
 #include "smooth/surface_graph.h"
 #include "voxpress/core/error.h"
 
 namespace voxpress {
-namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using detail::seconds_since;
+
+namespace {
 
 const char* axis_name(int a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 

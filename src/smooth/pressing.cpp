@@ -30,9 +30,13 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "core/timing.h"
 #include "voxpress/extract/cube_cases.h"
 
 namespace voxpress {
+
+using detail::seconds_since;
+
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
@@ -149,10 +153,6 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
   // Pass 2: the Laplacian of the Laplacian, interpolated at the same places.
   const auto lap_at = [&](const Where& x) { return Vec2(lap[x.k] + x.f * (lap[next(x.k)] - lap[x.k])); };
   for (size_t i = 0; i < n; ++i) w.disp[i] = s2 * (lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace

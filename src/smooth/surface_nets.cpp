@@ -18,17 +18,17 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/timing.h"
 #include "smooth/surface_graph.h"
 
 namespace voxpress {
+
+using detail::seconds_since;
+
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr int kSlotOffset[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 Vec3 index_vec(const std::array<int64_t, 3>& i) { return {double(i[0]), double(i[1]), double(i[2])}; }
 
