@@ -139,16 +139,16 @@ py::array_t<int32_t> int_rows(const std::vector<std::array<uint32_t, 3>>& rows) 
 void set_options(SurfaceOptions& o, const py::kwargs& kw) {
   for (const auto& [key, value] : kw) {
     const std::string k = py::str(key);
-    if (k == "iterations") o.iterations = value.cast<int>();
-    else if (k == "tolerance") o.tolerance = value.cast<double>();
+    if (k == "iterations") o.overrides.iterations = value.cast<int>();
+    else if (k == "tolerance") o.overrides.tolerance = value.cast<double>();
     else if (k == "flats") o.flats = value.cast<bool>();
     else if (k == "sharpen") o.sharpen = value.cast<bool>();
     else if (k == "min_flat_area") o.flat.min_area = value.cast<double>();
     else if (k == "junction_angle") o.flat.junction_angle = value.cast<double>();
     else if (k == "sharp_angle") o.sharp.sharp_angle = value.cast<double>();
     else if (k == "color_regions") o.color_regions = value.cast<bool>();
-    else if (k == "lambda_") o.lambda = value.cast<double>();
-    else if (k == "mu") o.mu = value.cast<double>();
+    else if (k == "lambda_") o.overrides.lambda = value.cast<double>();
+    else if (k == "mu") o.overrides.mu = value.cast<double>();
     else
       throw py::type_error("press() got an unknown option '" + k +
                            "' (iterations, tolerance, flats, sharpen, min_flat_area, junction_angle, sharp_angle, "

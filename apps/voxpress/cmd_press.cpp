@@ -17,7 +17,7 @@ struct PressCmd {
   bool no_flats = false, no_sharpen = false, color_regions = false;
   bool ascii = false, check = false;
   std::string method = "pressing";
-  MethodParams params;
+  MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
   CLI::App* cmd = nullptr;
 };
 
@@ -107,11 +107,11 @@ void run_press(const PressCmd& c, const Global& g) {
   so.sharp = c.sharpen;
   so.color_regions = c.color_regions;
   if (!pressing) {  // pressing reads these from so.press, with its own defaults
-    if (c.smooth.iterations_option->count()) so.iterations = c.smooth.options.iterations;
-    if (c.smooth.tolerance_option->count()) so.tolerance = c.smooth.options.tolerance;
+    if (c.smooth.iterations_option->count()) so.overrides.iterations = c.smooth.options.iterations;
+    if (c.smooth.tolerance_option->count()) so.overrides.tolerance = c.smooth.options.tolerance;
   }
-  so.lambda = c.params.lambda;
-  so.mu = c.params.mu;
+  so.overrides.lambda = c.overrides.lambda;
+  so.overrides.mu = c.overrides.mu;
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   so.progress = bar.get();
@@ -183,7 +183,7 @@ void register_press(CLI::App& app, Global& g) {
       ->capture_default_str();
   c->in.bind(*cmd);
   c->smooth.bind(*cmd);
-  c->params.bind_fairing(*cmd->add_option_group("fairing", "Taubin / Laplacian (--method taubin|laplacian)"));
+  bind_fairing(*cmd->add_option_group("fairing", "Taubin / Laplacian (--method taubin|laplacian)"), c->overrides);
   auto* f = cmd->add_option_group("flats", "Flats (plane voting) and junctions");
   f->add_flag("--no-flats", c->no_flats, "Do not look for flats: every vertex is smoothed");
   f->add_option("--min-flat-area", c->flats.min_area, "Smallest flat, in cell areas")->capture_default_str();

@@ -10,7 +10,7 @@ namespace {
 struct SmoothMeshCmd {
   std::string input, output, stats_json;
   std::string method = "constrained", constraint = "diamond";
-  MethodParams params;
+  MethodOverrides overrides;
   bool ascii = false;
   CLI::Option* constraint_option = nullptr;
 };
@@ -22,7 +22,7 @@ void run_smooth_mesh(const SmoothMeshCmd& c, const Global& g) {
     throw UsageError("--method must be constrained, taubin or laplacian (got '" + c.method + "')");
   const MeshConstraint constraint = parse_constraint(c.constraint);
   if (kind && c.constraint_option->count()) throw UsageError("--constraint applies to --method constrained only");
-  if (!kind && (c.params.lambda || c.params.mu)) throw UsageError("--lambda and --mu apply to taubin and laplacian only");
+  if (!kind && (c.overrides.lambda || c.overrides.mu)) throw UsageError("--lambda and --mu apply to taubin and laplacian only");
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   MeshReadOptions ro;
@@ -37,12 +37,19 @@ void run_smooth_mesh(const SmoothMeshCmd& c, const Global& g) {
   double seconds_recover = 0;
   if (kind) {
     if (mesh.triangles.empty()) throw InputError(c.input, "the mesh has no triangles");
-    st = fair(mesh, c.params.fairing(*kind, bar.get()));
+    FairOptions fo = fair_defaults(*kind);
+    c.overrides.apply(fo);
+    fo.progress = bar.get();
+    st = fair(mesh, fo);
     j["method"] = c.method;
   } else {
     LatticeMesh lm = recover_lattice(std::move(mesh), c.input);
     seconds_recover = clock.seconds() - seconds_read;
-    st = constrained_smooth(lm, c.params.constrained(constraint, bar.get()));
+    ConstrainedOptions co;
+    co.constraint = constraint;
+    c.overrides.apply(co);
+    co.progress = bar.get();
+    st = constrained_smooth(lm, co);
     mesh = std::move(lm.mesh);
     j["method"] = "constrained";
     j["constraint"] = constraint_name(constraint);
@@ -81,10 +88,10 @@ void register_smooth_mesh(CLI::App& app, Global& g) {
   c->constraint_option = cmd->add_option("--constraint", c->constraint,
                   "diamond | cell-edge (both keep every sample on its side) | cell-size (no guarantee)")
       ->capture_default_str();
-  cmd->add_option("--iterations", c->params.iterations, "Iteration cap (default 1000; taubin 110, laplacian 20)");
-  cmd->add_option("--tolerance", c->params.tolerance,
+  cmd->add_option("--iterations", c->overrides.iterations, "Iteration cap (default 1000; taubin 110, laplacian 20)");
+  cmd->add_option("--tolerance", c->overrides.tolerance,
                   "Stop when no vertex moved more than this in one iteration, in cells (default 0.002)");
-  c->params.bind_fairing(*cmd);
+  bind_fairing(*cmd, c->overrides);
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_option("--stats-json", c->stats_json, "Write the recovered lattice, iterations and timings as JSON");
   cmd->callback([c, &g] {

@@ -177,27 +177,9 @@ PressOptions PressCli::resolve() const {
   return o;
 }
 
-void MethodParams::bind_fairing(CLI::App& cmd) {
-  cmd.add_option("--lambda", lambda, "Taubin / Laplacian step (default 0.7143 taubin, 0.5 laplacian)");
-  cmd.add_option("--mu", mu, "Taubin's negative step (default -0.7692)");
-}
-
-ConstrainedOptions MethodParams::constrained(MeshConstraint c, Progress* progress) const {
-  ConstrainedOptions o;
-  o.constraint = c;
-  if (iterations) o.max_iterations = *iterations;
-  if (tolerance) o.threshold = *tolerance;
-  o.progress = progress;
-  return o;
-}
-
-FairOptions MethodParams::fairing(FairOptions::Kind kind, Progress* progress) const {
-  FairOptions o = fair_defaults(kind);
-  if (iterations) o.iterations = *iterations;
-  if (lambda) o.lambda = *lambda;
-  if (mu) o.mu = *mu;
-  o.progress = progress;
-  return o;
+void bind_fairing(CLI::App& cmd, MethodOverrides& overrides) {
+  cmd.add_option("--lambda", overrides.lambda, "Taubin / Laplacian step (default 0.7143 taubin, 0.5 laplacian)");
+  cmd.add_option("--mu", overrides.mu, "Taubin's negative step (default -0.7692)");
 }
 
 std::optional<FairOptions::Kind> fair_kind(const std::string& method) {

@@ -92,16 +92,8 @@ struct PressCli {
 };
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o);
 
-/// The parameters of `smooth-mesh` (Bade's constraints, Taubin, Laplacian);
-/// unset ones take each method's default.
-struct MethodParams {
-  std::optional<int> iterations;
-  std::optional<double> tolerance, lambda, mu;
-  /// Adds --lambda and --mu (Taubin / Laplacian) to a command or group.
-  void bind_fairing(CLI::App& cmd);
-  ConstrainedOptions constrained(MeshConstraint c, Progress* progress) const;
-  FairOptions fairing(FairOptions::Kind kind, Progress* progress) const;
-};
+/// Adds --lambda and --mu (Taubin / Laplacian) to a command or group.
+void bind_fairing(CLI::App& cmd, MethodOverrides& overrides);
 /// "taubin" or "laplacian" -> its kind; nullopt otherwise.
 std::optional<FairOptions::Kind> fair_kind(const std::string& method);
 nlohmann::json smooth_stats_json(const SmoothStats& st);

@@ -4,7 +4,12 @@
 
 #include <chrono>
 
+#include "core/timing.h"
+
 namespace voxpress {
+
+using detail::seconds_since;
+
 namespace {
 
 struct Named {
@@ -15,10 +20,6 @@ constexpr Named kMethods[] = {{Method::pressing, "pressing"},   {Method::cesn, "
                               {Method::diamond, "diamond"},     {Method::cell_edge, "cell-edge"},
                               {Method::cell_size, "cell-size"}, {Method::taubin, "taubin"},
                               {Method::laplacian, "laplacian"}};
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 
@@ -37,12 +38,34 @@ Method parse_method(const std::string& name) {
   throw UsageError("unknown method '" + name + "' (expected " + all + ")");
 }
 
+void MethodOverrides::apply(PressOptions& o) const {
+  if (iterations) o.iterations = *iterations;
+  if (tolerance) o.tolerance = *tolerance;
+}
+
+void MethodOverrides::apply(SurfaceNetOptions& o) const {
+  if (iterations) o.max_iterations = *iterations;
+  if (tolerance) o.threshold = *tolerance;
+}
+
+void MethodOverrides::apply(ConstrainedOptions& o) const {
+  if (iterations) o.max_iterations = *iterations;
+  if (tolerance) o.threshold = *tolerance;
+}
+
+void MethodOverrides::apply(FairOptions& o) const {
+  if (iterations) o.iterations = *iterations;
+  if (lambda) o.lambda = *lambda;
+  if (mu) o.mu = *mu;
+}
+
 bool keeps_classification(Method m) {
   return m == Method::pressing || m == Method::diamond || m == Method::cell_edge;
 }
 
 SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
-  if ((o.lambda || o.mu) && o.method != Method::taubin && o.method != Method::laplacian)
+  const MethodOverrides& ov = o.overrides;
+  if ((ov.lambda || ov.mu) && o.method != Method::taubin && o.method != Method::laplacian)
     throw UsageError("lambda and mu apply to taubin and laplacian only");
   require_mixed(volume);
   SurfaceResult r;
@@ -57,8 +80,7 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
       PressOptions po = o.press;
       FlatOptions fo = o.flat;
       if (o.progress) po.progress = fo.progress = o.progress;
-      if (o.iterations) po.iterations = *o.iterations;
-      if (o.tolerance) po.tolerance = *o.tolerance;
+      ov.apply(po);
       const SliceCurves curves = build_slice_curves(surface);
       r.press = press_with_flats(surface, curves, po, o.flats ? &fo : nullptr, &r.flats).press;
       if (o.flats && o.sharpen) {
@@ -75,8 +97,7 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
     }
     case Method::cesn: {
       SurfaceNetOptions so;
-      if (o.iterations) so.max_iterations = *o.iterations;
-      if (o.tolerance) so.threshold = *o.tolerance;
+      ov.apply(so);
       so.progress = o.progress;
       r.mesh = constrained_surface_net(surface, so, &r.net);
       break;
@@ -84,9 +105,7 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
     case Method::taubin:
     case Method::laplacian: {
       FairOptions fo = fair_defaults(o.method == Method::taubin ? FairOptions::Kind::taubin : FairOptions::Kind::laplacian);
-      if (o.iterations) fo.iterations = *o.iterations;
-      if (o.lambda) fo.lambda = *o.lambda;
-      if (o.mu) fo.mu = *o.mu;
+      ov.apply(fo);
       fo.progress = o.progress;
       r.mesh = to_mesh(surface);
       r.smooth = fair(r.mesh, fo);
@@ -99,8 +118,7 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
       co.constraint = o.method == Method::diamond     ? MeshConstraint::diamond
                       : o.method == Method::cell_edge ? MeshConstraint::cell_edge
                                                       : MeshConstraint::cell_size;
-      if (o.iterations) co.max_iterations = *o.iterations;
-      if (o.tolerance) co.threshold = *o.tolerance;
+      ov.apply(co);
       co.progress = o.progress;
       LatticeMesh lm = lattice_mesh(surface);
       r.smooth = constrained_smooth(lm, co);

@@ -42,7 +42,7 @@ TEST(Pipeline, PressingStagesAndOverridesAreHonoured) {
   EXPECT_TRUE(chamfered.mesh.edges.empty());
   EXPECT_EQ(chamfered.mesh.vertex_count(), chamfered.extract.sticks);
   o.flats = false;
-  o.iterations = 3;
+  o.overrides.iterations = 3;
   const SurfaceResult plain = smooth_surface(box.volume, o);
   EXPECT_TRUE(plain.flats.flats.empty());
   EXPECT_EQ(plain.press.iterations, 3);
@@ -51,7 +51,7 @@ TEST(Pipeline, PressingStagesAndOverridesAreHonoured) {
 TEST(Pipeline, RefusesBadOptionsAndEmptyVolumes) {
   SurfaceOptions o;
   o.method = Method::diamond;
-  o.lambda = 0.3;
+  o.overrides.lambda = 0.3;
   const BinaryVolume ball = generate_shape(ShapeKind::sphere, GenerateOptions{}).volume;
   EXPECT_THROW(smooth_surface(ball, o), UsageError);
   EXPECT_THROW(parse_method("smooth"), UsageError);

@@ -37,6 +37,18 @@ Method parse_method(const std::string& name);
 /// True for the methods that keep every lattice sample on its side.
 bool keeps_classification(Method m);
 
+/// What a user set of a method's iteration cap, stopping tolerance and
+/// Taubin / Laplacian steps; unset fields keep the method's own default.
+/// Shared by smooth_surface and the mesh-only path (`voxpress smooth-mesh`).
+struct MethodOverrides {
+  std::optional<int> iterations;
+  std::optional<double> tolerance, lambda, mu;
+  void apply(PressOptions& o) const;        ///< iterations, tolerance
+  void apply(SurfaceNetOptions& o) const;   ///< max_iterations, threshold
+  void apply(ConstrainedOptions& o) const;  ///< max_iterations, threshold
+  void apply(FairOptions& o) const;         ///< iterations, lambda, mu
+};
+
 struct SurfaceOptions {
   Method method = Method::pressing;
   // --- pressing
@@ -47,11 +59,9 @@ struct SurfaceOptions {
   SharpenOptions sharp;
   bool color_regions = false;  ///< vertex colours per region
   // --- every method: when set, the iteration cap and the stopping tolerance
-  // (pressing: press.iterations / press.tolerance; the others: their
-  // ConstrainedOptions, SurfaceNetOptions or fair_defaults); lambda and mu
-  // for taubin and laplacian only (UsageError otherwise)
-  std::optional<int> iterations;
-  std::optional<double> tolerance, lambda, mu;
+  // (pressing: over press.iterations / press.tolerance); lambda and mu for
+  // taubin and laplacian only (UsageError otherwise)
+  MethodOverrides overrides;
   // --- all
   ExtractOptions extract;
   Progress* progress = nullptr;  ///< overrides the stages' own progress pointers
