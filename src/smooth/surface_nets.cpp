@@ -97,7 +97,7 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
     const uint64_t id = by_cell[g].first;
     const std::array<int64_t, 3> cell{int64_t(id % uint64_t(P[0])) - 1, int64_t(id / uint64_t(P[0]) % uint64_t(P[1])) - 1,
                                       int64_t(id / (uint64_t(P[0]) * uint64_t(P[1]))) - 1};
-    int patch_of_root[12];
+    int patch_of_root[12], sticks_of_patch[12] = {};
     std::fill(patch_of_root, patch_of_root + 12, -1);
     const uint32_t first = uint32_t(x.size());
     for (int i = 0; i < count; ++i) {
@@ -107,6 +107,7 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
         x.push_back(Vec3::Zero());
         box.push_back({Vec3::Constant(HUGE_VAL), Vec3::Constant(-HUGE_VAL)});
       }
+      ++sticks_of_patch[patch_of_root[r]];
       const uint32_t p = first + uint32_t(patch_of_root[r]);
       const uint32_t s = local[i];
       const int a = surface.axis(s), b = (a + 1) % 3, c = (a + 2) % 3;
@@ -124,9 +125,7 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
     }
     const uint32_t patches = uint32_t(x.size()) - first;
     for (uint32_t p = first; p < x.size(); ++p) {
-      int sticks = 0;
-      for (int i = 0; i < count; ++i) sticks += first + uint32_t(patch_of_root[root(i)]) == p;
-      x[p] /= double(sticks);
+      x[p] /= double(sticks_of_patch[p - first]);
       if (patches == 1) {  // Gibson: the whole cell
         box[p].lo = index_vec(cell);
         box[p].hi = box[p].lo + Vec3::Ones();
