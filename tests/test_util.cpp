@@ -12,6 +12,37 @@ namespace voxpress::test {
 
 namespace fs = std::filesystem;
 
+void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+std::string le32(int32_t v) {
+  std::string s(4, '\0');
+  for (int b = 0; b < 4; ++b) s[size_t(b)] = char((uint32_t(v) >> (8 * b)) & 0xff);
+  return s;
+}
+
+std::string vox_chunk(const std::string& id, const std::string& content, const std::string& children) {
+  return id + le32(int32_t(content.size())) + le32(int32_t(children.size())) + content + children;
+}
+
+std::string vox_dict(const std::vector<std::pair<std::string, std::string>>& entries) {
+  std::string s = le32(int32_t(entries.size()));
+  for (const auto& [k, v] : entries) s += le32(int32_t(k.size())) + k + le32(int32_t(v.size())) + v;
+  return s;
+}
+
+std::string vox_model(std::array<int, 3> size, const std::vector<std::array<uint8_t, 4>>& voxels) {
+  std::string xyzi = le32(int32_t(voxels.size()));
+  for (const auto& v : voxels) xyzi += std::string(reinterpret_cast<const char*>(v.data()), 4);
+  return vox_chunk("SIZE", le32(size[0]) + le32(size[1]) + le32(size[2])) + vox_chunk("XYZI", xyzi);
+}
+
+std::string vox_file(const std::string& main_children, int32_t version) {
+  return "VOX " + le32(version) + vox_chunk("MAIN", "", main_children);
+}
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});

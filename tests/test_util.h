@@ -79,6 +79,19 @@ struct Case {
 /// generated volumes (also reused by later methods' property tests).
 std::vector<Case> property_volumes();
 
+/// Writes bytes to a file (test inputs).
+void write_file(const std::string& path, const std::string& bytes);
+
+/// MagicaVoxel .vox building blocks: a little-endian int32, a chunk (id,
+/// content, children), a DICT, and a whole file with one model (voxels are
+/// x, y, z, colour index 1..255; an RGBA chunk when `palette` has 256
+/// entries) followed by `extra` chunks inside MAIN.
+std::string le32(int32_t v);
+std::string vox_chunk(const std::string& id, const std::string& content, const std::string& children = {});
+std::string vox_dict(const std::vector<std::pair<std::string, std::string>>& entries);
+std::string vox_model(std::array<int, 3> size, const std::vector<std::array<uint8_t, 4>>& voxels);
+std::string vox_file(const std::string& main_children, int32_t version = 150);
+
 /// Runs the voxpress CLI with `args`; returns the exit code, fills output
 /// with stdout and stderr combined.
 int run_cli(const std::string& args, std::string* output = nullptr);

@@ -150,5 +150,6 @@ void register_eval(CLI::App& app, Global& g);
 void register_press(CLI::App& app, Global& g);
 void register_press2d(CLI::App& app, Global& g);
 void register_smooth_mesh(CLI::App& app, Global& g);
+void register_voxart(CLI::App& app, Global& g);
 
 }  // namespace voxpress::cli

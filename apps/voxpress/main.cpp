@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   cli::register_press(app, g);
   cli::register_press2d(app, g);
   cli::register_smooth_mesh(app, g);
+  cli::register_voxart(app, g);
 
   try {
     app.parse(argc, argv);

@@ -21,6 +21,8 @@
 #include "voxpress/smooth/pipeline.h"
 #include "voxpress/smooth/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
+#include "voxpress/voxart/polygonize.h"
+#include "voxpress/voxart/voxel_art.h"
 
 namespace voxpress {
 inline constexpr const char* kVersion = "0.1.0";

@@ -33,6 +33,10 @@ void Mesh::validate(const std::string& source) const {
       throw InputError(source, "edge " + std::to_string(e) + " uses a vertex beyond the " + std::to_string(nv) + " vertices");
   if (!normals.empty() && normals.size() != nv) throw InputError(source, "normal count differs from vertex count");
   if (!colors.empty() && colors.size() != nv) throw InputError(source, "color count differs from vertex count");
+  if (!uvs.empty() && uvs.size() != nv) throw InputError(source, "texture coordinate count differs from vertex count");
+  if (!texture.empty() && (texture.width < 0 || texture.height < 0 ||
+                           texture.rgba.size() != uint64_t(texture.width) * uint64_t(texture.height) * 4))
+    throw InputError(source, "texture size differs from width x height x 4");
   for (const auto& a : vertex_attributes)
     if (a.values.size() != nv) throw InputError(source, "vertex attribute '" + a.name + "' has the wrong length");
   for (const auto& a : face_attributes)

@@ -11,6 +11,7 @@
 
 #include "formats.h"
 #include "io_util.h"
+#include "voxpress/io/image_io.h"
 
 namespace voxpress::detail {
 namespace {
@@ -71,8 +72,21 @@ Mesh read_obj(const std::string& path, uint64_t max_bytes) {
 
 void write_obj(const std::string& path, const Mesh& m) {
   m.validate(path);
+  // A texture goes beside the OBJ as STEM.png with STEM.mtl naming it; both
+  // are written (atomically) before the OBJ, so a complete OBJ always finds them.
+  const std::filesystem::path obj_path(path);
+  const std::string stem = obj_path.stem().string();
+  if (!m.texture.empty()) {
+    const auto dir = obj_path.parent_path();
+    write_png((dir / (stem + ".png")).string(), m.texture.width, m.texture.height, m.texture.rgba);
+    write_stream_atomically((dir / (stem + ".mtl")).string(), [&](std::ostream& out) {
+      out << "# written by voxpress\nnewmtl voxpress\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << stem
+          << ".png\n";
+    });
+  }
   write_stream_atomically(path, [&](std::ostream& out) {
     std::string buf = "# written by voxpress\n";
+    if (!m.texture.empty()) buf += "mtllib " + stem + ".mtl\nusemtl voxpress\n";
     for (size_t v = 0; v < m.positions.size(); ++v) {
       const Vec3& p = m.positions[v];
       buf += "v " + fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z());
@@ -84,9 +98,12 @@ void write_obj(const std::string& path, const Mesh& m) {
         buf.clear();
       }
     }
-    const bool vn = !m.normals.empty();
+    const bool vn = !m.normals.empty(), vt = !m.uvs.empty();
     if (vn)
       for (const Vec3& n : m.normals) buf += "vn " + fmt(n.x()) + " " + fmt(n.y()) + " " + fmt(n.z()) + "\n";
+    // OBJ's v axis points up the image, glTF's (ours) down.
+    if (vt)
+      for (const Vec2& t : m.uvs) buf += "vt " + fmt(t.x()) + " " + fmt(1.0 - t.y()) + "\n";
     // Faces with a "region" attribute are grouped per region (g flat_<id>,
     // g curved), in a stable order; labelled edges become "l" records.
     std::vector<size_t> order(m.triangles.size());
@@ -101,7 +118,11 @@ void write_obj(const std::string& path, const Mesh& m) {
         buf += r < 0 ? std::string("g curved\n") : "g flat_" + std::to_string(int64_t(r)) + "\n";
       }
       buf += "f";
-      for (uint32_t i : m.triangles[order[k]]) buf += " " + std::to_string(i + 1) + (vn ? "//" + std::to_string(i + 1) : "");
+      for (uint32_t i : m.triangles[order[k]]) {
+        const std::string id = std::to_string(i + 1);
+        buf += " " + id;
+        if (vt || vn) buf += "/" + (vt ? id : std::string()) + (vn ? "/" + id : std::string());
+      }
       buf += "\n";
       if (buf.size() > (1 << 20)) {
         out << buf;
@@ -174,6 +195,15 @@ void write_gltf(const std::string& path, const Mesh& m, bool binary) {
     prim.attributes["COLOR_0"] =
         add_accessor(add_view(m.colors.data(), m.colors.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
                      TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, m.colors.size(), TINYGLTF_TYPE_VEC4, true);
+  if (!m.uvs.empty()) {
+    std::vector<float> t(2 * m.uvs.size());
+    for (size_t v = 0; v < m.uvs.size(); ++v) {
+      t[2 * v] = float(m.uvs[v].x());
+      t[2 * v + 1] = float(m.uvs[v].y());
+    }
+    prim.attributes["TEXCOORD_0"] = add_accessor(add_view(t.data(), t.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                                 TINYGLTF_COMPONENT_TYPE_FLOAT, m.uvs.size(), TINYGLTF_TYPE_VEC2);
+  }
   prim.indices = add_accessor(add_view(m.triangles.data(), m.triangles.size() * 12, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, m.triangles.size() * 3, TINYGLTF_TYPE_SCALAR);
   tinygltf::Material mat;
@@ -182,6 +212,35 @@ void write_gltf(const std::string& path, const Mesh& m, bool binary) {
   mat.pbrMetallicRoughness.metallicFactor = 0.0;
   mat.pbrMetallicRoughness.roughnessFactor = 0.8;
   mat.doubleSided = false;
+  if (!m.texture.empty() && !m.uvs.empty()) {
+    // The texture as an embedded PNG (a buffer view, also in .gltf's single
+    // data-URI buffer), sampled nearest so voxel colours stay crisp.
+    const auto png = encode_png(m.texture.width, m.texture.height, m.texture.rgba);
+    while (buffer.data.size() % 4) buffer.data.push_back(0);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.data.size();
+    view.byteLength = png.size();
+    buffer.data.insert(buffer.data.end(), png.begin(), png.end());
+    model.bufferViews.push_back(view);
+    tinygltf::Image image;
+    image.name = "voxpress_diffuse";
+    image.mimeType = "image/png";
+    image.bufferView = int(model.bufferViews.size() - 1);
+    model.images.push_back(image);
+    tinygltf::Sampler sampler;
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_NEAREST;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_NEAREST;
+    sampler.wrapS = sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    model.samplers.push_back(sampler);
+    tinygltf::Texture texture;
+    texture.source = 0;
+    texture.sampler = 0;
+    model.textures.push_back(texture);
+    mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+    mat.pbrMetallicRoughness.roughnessFactor = 1.0;
+  }
   model.materials.push_back(mat);
   prim.material = 0;
   tinygltf::Mesh mesh;

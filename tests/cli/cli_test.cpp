@@ -21,7 +21,7 @@ size_t count_lines(const std::string& s) {
 
 TEST(Cli, HelpOnEveryCommand) {
   for (const std::string cmd : {"", "info", "extract", "generate", "check", "voxelize", "eval", "press", "press2d",
-                                 "smooth-mesh"}) {
+                                 "smooth-mesh", "voxart"}) {
     std::string out;
     EXPECT_EQ(run_cli(cmd + " --help", &out), 0) << cmd;
     EXPECT_NE(out.find("Usage"), std::string::npos) << cmd;
@@ -494,6 +494,42 @@ TEST(Cli, PressRunsEveryMethodAndChecksOnlyWhatEachPromises) {
   EXPECT_NE(out.find("--no-flats applies to --method pressing only"), std::string::npos) << out;
   EXPECT_EQ(run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("x.ply") + " --lambda 0.2", &out), 2);
   EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
+}
+
+TEST(Cli, VoxartWritesATexturedGlbAndRefusesBrokenFiles) {
+  test::TempDir tmp;
+  std::vector<std::array<uint8_t, 4>> voxels;
+  for (uint8_t x = 0; x < 6; ++x)
+    for (uint8_t y = 0; y < 5; ++y)
+      for (uint8_t z = 0; z < 4; ++z)
+        if ((x - 3) * (x - 3) + (y - 2) * (y - 2) + (z - 2) * (z - 2) < 9) voxels.push_back({x, y, z, uint8_t(1 + x)});
+  const std::string vox = test::vox_file(test::vox_model({6, 5, 4}, voxels));
+  test::write_file(tmp.path("m.vox"), vox);
+  std::string out;
+  ASSERT_EQ(run_cli("voxart " + tmp.path("m.vox") + " -o " + tmp.path("m.glb") + " --faces 200 --stats-json " +
+                        tmp.path("s.json"),
+                    &out),
+            0)
+      << out;
+  const auto j = nlohmann::json::parse(test::read_file(tmp.path("s.json")));
+  EXPECT_EQ(j["counts"]["voxels"].get<uint64_t>(), voxels.size());
+  EXPECT_LE(j["counts"]["triangles"].get<uint64_t>(), 208u);
+  EXPECT_TRUE(j["surface"]["closed"].get<bool>() && j["surface"]["manifold"].get<bool>());
+  EXPECT_GT(j["atlas"]["utilisation"].get<double>(), 0.1);
+  EXPECT_GT(fs::file_size(tmp.path("m.glb")), 1000u);
+  ASSERT_EQ(run_cli("-q voxart " + tmp.path("m.vox") + " -o " + tmp.path("m.obj") + " --fairing taubin", &out), 0) << out;
+  EXPECT_TRUE(fs::exists(tmp.path("m.mtl")) && fs::exists(tmp.path("m.png")));
+  // Broken inputs: one line naming the file, exit 1, no output.
+  test::write_file(tmp.path("cut.vox"), vox.substr(0, vox.size() / 2));
+  test::write_file(tmp.path("bad.vxl"), "Voxel Animation");
+  for (const std::string name : {"cut.vox", "bad.vxl", "missing.vox"}) {
+    EXPECT_EQ(run_cli("voxart " + tmp.path(name) + " -o " + tmp.path("x.glb"), &out), 1) << name;
+    EXPECT_EQ(count_lines(out), 1u) << out;
+    EXPECT_NE(out.find(name), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(tmp.path("x.glb")));
+  }
+  EXPECT_EQ(run_cli("voxart " + tmp.path("m.vox") + " -o " + tmp.path("x.glb") + " --fairing gauss", &out), 2);
+  EXPECT_FALSE(fs::exists(tmp.path("x.glb")));
 }
 
 }  // namespace

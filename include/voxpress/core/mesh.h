@@ -26,6 +26,13 @@ struct MeshAttribute {
   std::vector<double> values;
 };
 
+/// An 8-bit RGBA image, rows from the top, 4 bytes per texel.
+struct Texture {
+  int64_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;  ///< width * height * 4
+  bool empty() const { return width == 0 || height == 0; }
+};
+
 struct Mesh {
   std::vector<Vec3> positions;
   std::vector<Triangle> triangles;
@@ -36,6 +43,13 @@ struct Mesh {
   /// Optional labelled edges: the sharp feature curves, as vertex pairs
   /// (PLY "edge" elements, OBJ "l" records).
   std::vector<std::array<uint32_t, 2>> edges;
+  /// Optional per-vertex texture coordinates in [0, 1], glTF convention:
+  /// (0, 0) is the top-left corner of `texture`, v grows downwards.
+  std::vector<Vec2> uvs;
+  /// Optional diffuse texture sampled through `uvs` (written by the glTF and
+  /// OBJ writers: embedded PNG / PNG + MTL beside the OBJ). Texels are meant
+  /// to be looked up with nearest filtering.
+  Texture texture;
 
   size_t vertex_count() const { return positions.size(); }
   size_t face_count() const { return triangles.size(); }
