@@ -128,11 +128,17 @@ Packing pack_paper(const std::vector<Chart>& charts) {
   }
   auto area = [&](int32_t i) { return nodes[size_t(i)].w * nodes[size_t(i)].h; };
   while (hb.size() > 1) {
-    const int32_t a1 = std::prev(hb.end())->second, a2 = std::prev(hb.end(), 2)->second;
-    const int32_t b1 = std::prev(vb.end())->second, b2 = std::prev(vb.end(), 2)->second;
+    // The two narrowest (stacked) or the two shortest (side by side): the
+    // "last two" of the paper's buffers sorted by decreasing size.
+    const int32_t a1 = hb.begin()->second, a2 = std::next(hb.begin())->second;
+    const int32_t b1 = vb.begin()->second, b2 = std::next(vb.begin())->second;
     const Node A{std::max(nodes[size_t(a1)].w, nodes[size_t(a2)].w), nodes[size_t(a1)].h + nodes[size_t(a2)].h, a1, a2, true};
     const Node B{nodes[size_t(b1)].w + nodes[size_t(b2)].w, std::max(nodes[size_t(b1)].h, nodes[size_t(b2)].h), b1, b2, false};
-    const int64_t wa = A.w * A.h - area(a1) - area(a2), wb = B.w * B.h - area(b1) - area(b2);
+    // Waste measured against the enclosing square (the paper squares the
+    // result): plain bounding-box waste keeps stacking narrow charts into
+    // one ever taller column.
+    const int64_t wa = std::max(A.w, A.h) * std::max(A.w, A.h) - area(a1) - area(a2);
+    const int64_t wb = std::max(B.w, B.h) * std::max(B.w, B.h) - area(b1) - area(b2);
     const Node chosen = wa <= wb ? A : B;
     for (int32_t i : {chosen.left, chosen.right}) {
       hb.erase({nodes[size_t(i)].w, i});

@@ -9,8 +9,8 @@
 // projection overlaps itself is grown again with half the angle (down to
 // single faces). Charts get `padding` texels on every side, filled by
 // dilating their colours. Packers: the paper's (repeatedly merge the two
-// widest stacked or the two tallest side by side, whichever wastes less, then
-// square and centre) and a shelf packer (rows by decreasing height);
+// narrowest stacked or the two shortest side by side, whichever wastes less
+// of its enclosing square, then square and centre) and a shelf packer (rows by decreasing height);
 // AtlasPacker::best keeps the smaller texture.
 #pragma once
 

@@ -378,7 +378,8 @@ TEST(Simplify, ReachesTheTargetAndStaysClosedManifoldAndOriented) {
     EXPECT_LE(m.triangles.size(), target + 2 * before.components * 4);
     EXPECT_NEAR(after.signed_volume, before.signed_volume, 0.15 * before.signed_volume);
     // Every kept vertex stays within a voxel of the faired surface.
-    const detail::MeshQuery original(quad_mesh(q));
+    const Mesh faired = quad_mesh(q);  // MeshQuery keeps a reference
+    const detail::MeshQuery original(faired);
     double worst = 0;
     for (const Vec3& p : m.positions) worst = std::max(worst, std::sqrt(original.closest(p).dist2));
     EXPECT_LT(worst, 1.0);

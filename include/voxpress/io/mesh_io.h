@@ -2,9 +2,11 @@
 //
 // Writers (format from the extension): .ply (binary little-endian by
 // default, or ASCII; positions as double; normals, RGBA colours and every
-// named vertex/face attribute as properties), .obj, .stl (binary; float32
-// per the format), .off, .glb / .gltf (glTF 2.0; float32 positions, uint32
-// indices, optional normals and colours). Every write is atomic.
+// named vertex/face attribute as properties), .obj (with texture
+// coordinates, and the texture as STEM.png + STEM.mtl beside it), .stl
+// (binary; float32 per the format), .off, .glb / .gltf (glTF 2.0; float32
+// positions, uint32 indices, optional normals, colours, texture coordinates
+// and an embedded PNG texture sampled nearest). Every write is atomic.
 // Readers: .ply (ASCII and binary of either endianness, any extra properties
 // kept as attributes, polygons fanned into triangles), .obj (tinyobjloader,
 // double precision), .stl (binary — even when the header starts with
