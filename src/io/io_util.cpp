@@ -61,6 +61,12 @@ uint64_t file_size(const std::string& path) {
   return size;
 }
 
+std::vector<std::byte> read_whole_file(const std::string& path, uint64_t cap, const std::string& what) {
+  const uint64_t size = file_size(path);
+  check_limit(path, size, cap, what);
+  return read_range(path, 0, size);
+}
+
 void read_range_into(const std::string& path, uint64_t offset, std::byte* out, uint64_t size) {
   const uint64_t total = file_size(path);
   if (offset > total || size > total - offset)

@@ -26,6 +26,8 @@ uint64_t file_size(const std::string& path);
 /// Reads [offset, offset + size) of a file; throws InputError naming `label`
 /// when the file is shorter.
 std::vector<std::byte> read_range(const std::string& path, uint64_t offset, uint64_t size);
+/// A whole file, refused with LimitError(path, ...) above `cap` bytes.
+std::vector<std::byte> read_whole_file(const std::string& path, uint64_t cap, const std::string& what);
 void read_range_into(const std::string& path, uint64_t offset, std::byte* out, uint64_t size);
 
 /// Inflates a gzip or zlib stream (auto-detected, multi-member gzip allowed)

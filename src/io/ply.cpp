@@ -138,9 +138,7 @@ class Cursor {
 }  // namespace
 
 Mesh read_ply(const std::string& path, uint64_t max_bytes) {
-  const uint64_t fs = file_size(path);
-  check_limit(path, fs, max_bytes, "the file");
-  const auto buf = read_range(path, 0, fs);
+  const auto buf = read_whole_file(path, max_bytes, "the file");
   const char* data = reinterpret_cast<const char*>(buf.data());
   const std::string head(data, std::min<size_t>(buf.size(), 1 << 20));
   if (head.rfind("ply", 0) != 0 || head.size() < 4 || (head[3] != '\n' && head[3] != '\r'))

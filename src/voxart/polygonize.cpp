@@ -173,17 +173,23 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
     }
   }
   st.seconds_fair = seconds_since(t0);
-  if (!pressing) {
+  // Final triangle f is a triangle of quad tri_quad[f] unless the surface was
+  // pressed or will be simplified; then colours come from the closest point
+  // of `reference` (the faired surface before simplification, or the cube
+  // faces for pressing), queried through a BVH built only in that case.
+  const bool simplify = options.target_faces > 0 && options.target_faces < work.triangles.size();
+  const bool direct = !pressing && !simplify;
+  if (!pressing && simplify) {
     reference = work;
     ref_quad = tri_quad;
   }
-  const detail::MeshQuery ref_query(reference);
-  auto reference_color = [&](const Vec3& p) { return quad_color[ref_quad[ref_query.closest(p).face]]; };
+  std::optional<detail::MeshQuery> ref_query;
+  if (!direct) ref_query.emplace(reference);
+  auto reference_color = [&](const Vec3& p) { return quad_color[ref_quad[ref_query->closest(p).face]]; };
 
   // 4. Simplification (before the atlas; see polygonize.h).
   t0 = Clock::now();
-  bool direct = !pressing;  // final triangle f is a triangle of quad tri_quad[f]
-  if (options.target_faces > 0 && options.target_faces < work.triangles.size()) {
+  if (simplify) {
     std::vector<uint32_t> keys(work.triangles.size());
     if (pressing)
       for (size_t f = 0; f < keys.size(); ++f) {
@@ -193,18 +199,18 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
     else
       for (size_t f = 0; f < keys.size(); ++f) keys[f] = pack(quad_color[tri_quad[f]]);
     simplify_mesh(work, options.target_faces, keys);
-    direct = false;
   }
   st.seconds_simplify = seconds_since(t0);
   auto face_color = [&](uint32_t f, const Vec3& p) { return direct ? quad_color[tri_quad[f]] : reference_color(p); };
 
   // 3. Attributes (Section 4.4): normals from the distinct adjacent face
-  // normals, colours from the adjacent faces.
+  // normals, colours from the adjacent faces (only without a texture, the
+  // only output that carries them).
   t0 = Clock::now();
   {
     const size_t nv = work.positions.size(), nf = work.triangles.size();
     std::vector<Vec3> fn(nf);
-    std::vector<Rgba> fc(nf);
+    std::vector<Rgba> fc(options.texture ? 0 : nf);
     std::vector<uint32_t> start(nv + 1, 0), adj(3 * nf);
     for (size_t f = 0; f < nf; ++f) {
       const auto& t = work.triangles[f];
@@ -212,7 +218,7 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
       fn[f] = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero();
       for (uint32_t v : t) ++start[v + 1];
     }
-    tbb::parallel_for(size_t(0), nf, [&](size_t f) {
+    tbb::parallel_for(size_t(0), fc.size(), [&](size_t f) {
       const auto& t = work.triangles[f];
       fc[f] = face_color(uint32_t(f), (work.positions[t[0]] + work.positions[t[1]] + work.positions[t[2]]) / 3);
     });
@@ -221,14 +227,15 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
     for (uint32_t f = 0; f < nf; ++f)
       for (uint32_t v : work.triangles[f]) adj[fill[v]++] = f;
     work.normals.assign(nv, Vec3::UnitZ());
-    work.colors.assign(nv, Rgba{0, 0, 0, 255});
+    if (!options.texture) work.colors.assign(nv, Rgba{0, 0, 0, 255});
     tbb::parallel_for(size_t(0), nv, [&](size_t v) {
       std::vector<Vec3> seen;
       Vec3 sum = Vec3::Zero();
       double rgb[3] = {0, 0, 0};
       for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
         const uint32_t f = adj[k];
-        for (int c = 0; c < 3; ++c) rgb[c] += fc[f][size_t(c)];
+        if (!fc.empty())
+          for (int c = 0; c < 3; ++c) rgb[c] += fc[f][size_t(c)];
         const Vec3& n = fn[f];
         if (std::none_of(seen.begin(), seen.end(), [&](const Vec3& s) { return (s - n).squaredNorm() < 1e-12; })) {
           seen.push_back(n);
@@ -237,7 +244,8 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
       }
       if (sum.norm() > 0) work.normals[v] = sum.normalized();
       const double k = std::max<double>(1, start[v + 1] - start[v]);
-      for (int c = 0; c < 3; ++c) work.colors[v][size_t(c)] = uint8_t(std::lround(rgb[c] / k));
+      if (!fc.empty())
+        for (int c = 0; c < 3; ++c) work.colors[v][size_t(c)] = uint8_t(std::lround(rgb[c] / k));
     });
   }
   st.seconds_attributes = seconds_since(t0);
@@ -288,15 +296,13 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
     for (const ColorGrid& g : art.parts)
       for (int a = 0; a < 3; ++a) voxel = std::min(voxel, g.linear.col(a).norm());
     int k = options.texels_per_voxel > 0 ? options.texels_per_voxel : 4;
-    Mesh atlas_in = work;
-    atlas_in.colors.clear();
     for (;;) {
       detail::AtlasOptions ao;
       ao.angle_degrees = options.chart_angle;
       ao.texels_per_unit = k / voxel;
       ao.padding = options.padding;
       ao.packer = options.packer;
-      detail::AtlasResult a = detail::build_atlas(atlas_in, ao, face_color);
+      detail::AtlasResult a = detail::build_atlas(work, ao, face_color);
       const int64_t side = std::max(a.mesh.texture.width, a.mesh.texture.height);
       const bool too_big = side > options.max_texture;
       if (!too_big) st.color_exact = color_exact(a.mesh);

@@ -124,9 +124,7 @@ Placement parse_frame(const std::string& path, const Dict& frame) {
 
 VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
   const uint64_t cap = options.max_bytes ? options.max_bytes : default_memory_limit();
-  const uint64_t fs = file_size(path);
-  check_limit(path, fs, cap, "reading the .vox file");
-  const auto data = read_range(path, 0, fs);
+  const auto data = read_whole_file(path, cap, "reading the .vox file");
   ByteCursor c(path, data, 0, data.size());
   if (c.left() < 8 || c.text(4, "header") != "VOX ") throw InputError(path, "not a MagicaVoxel file (no 'VOX ' magic)");
   const uint32_t version = c.u32("header");

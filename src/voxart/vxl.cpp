@@ -80,9 +80,8 @@ std::vector<std::pair<std::string, Matrix34>> read_hva(const std::string& vxl_pa
 
 VoxelArt read_vxl(const std::string& path, const VoxelArtReadOptions& options) {
   const uint64_t cap = options.max_bytes ? options.max_bytes : default_memory_limit();
-  const uint64_t fs = file_size(path);
-  check_limit(path, fs, cap, "reading the .vxl file");
-  const auto data = read_range(path, 0, fs);
+  const auto data = read_whole_file(path, cap, "reading the .vxl file");
+  const uint64_t fs = data.size();
   ByteCursor c(path, data, 0, data.size());
   if (data.size() < 16 || c.text(15, "header") != "Voxel Animation")
     throw InputError(path, "not a Westwood voxel file (no 'Voxel Animation' magic)");

@@ -153,15 +153,16 @@ TEST(VoxReader, MalformedFilesGiveOneLineErrors) {
   for (size_t n = 0; n < good.size(); n += 7) expect_input_error(file("cut.vox", good.substr(0, n)), "cut.vox");
 }
 
+std::string f32(float v) {
+  uint32_t b;
+  std::memcpy(&b, &v, 4);
+  return le32(int32_t(b));
+}
+
 // A minimal .vxl: one section of size (2, 1, 3), voxels at (0, 0, 0) colour
 // 5 and (1, 0, 1), (1, 0, 2) colour 9; bounds (0..4, 0..1, 0..6) make the
 // voxels 2 x 1 x 2 units; det 0.5 scales the translation (2, 0, 0).
 std::string vxl_bytes() {
-  auto f32 = [](float v) {
-    uint32_t b;
-    std::memcpy(&b, &v, 4);
-    return le32(int32_t(b));
-  };
   std::string spans;
   const std::string col0 = std::string{char(0), char(1), char(5), char(0), char(1)};           // skip 0, 1 voxel
   const std::string col1 = std::string{char(1), char(2), char(9), char(0), char(9), char(0), char(2)};  // skip 1, 2 voxels
@@ -209,11 +210,6 @@ TEST(VxlReader, SectionsSpansPaletteAndPlacement) {
 TEST(VxlReader, HvaFrameOverridesTheTailerTransform) {
   test::TempDir dir;
   test::write_file(dir.path("u.vxl"), vxl_bytes());
-  auto f32 = [](float v) {
-    uint32_t b;
-    std::memcpy(&b, &v, 4);
-    return le32(int32_t(b));
-  };
   std::string hva = std::string("u") + std::string(15, '\0') + le32(2) + le32(1) + std::string("Body") + std::string(12, '\0');
   for (float t : {0.f, 8.f}) {
     const float m[12] = {1, 0, 0, t, 0, 1, 0, 0, 0, 0, 1, 0};
