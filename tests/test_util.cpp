@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sys/wait.h>
@@ -43,6 +44,37 @@ std::string vox_file(const std::string& main_children, int32_t version) {
   return "VOX " + le32(version) + vox_chunk("MAIN", "", main_children);
 }
 
+std::string f32(float v) {
+  uint32_t b;
+  std::memcpy(&b, &v, 4);
+  return le32(int32_t(b));
+}
+
+// One section of size (2, 1, 3), voxels at (0, 0, 0) colour 5 and (1, 0, 1),
+// (1, 0, 2) colour 9; bounds (0..4, 0..1, 0..6) make the voxels 2 x 1 x 2
+// units; det 0.5 scales the translation (2, 0, 0).
+std::string vxl_file() {
+  const std::string col0 = std::string{char(0), char(1), char(5), char(0), char(1)};  // skip 0, 1 voxel
+  const std::string col1 = std::string{char(1), char(2), char(9), char(0), char(9), char(0), char(2)};  // skip 1, 2
+  const std::string body = le32(0) + le32(int32_t(col0.size())) +  // span starts
+                           le32(int32_t(col0.size()) - 1) + le32(int32_t(col0.size() + col1.size()) - 1) +  // ends
+                           col0 + col1;
+  std::string palette(768, '\0');
+  palette[15] = char(200);  // colour 5 = (200, 0, 0)
+  palette[27] = char(10);   // colour 9 = (10, 20, 30)
+  palette[28] = char(20);
+  palette[29] = char(30);
+  const std::string header = std::string("Voxel Animation") + '\0' + le32(1) + le32(1) + le32(1) +
+                             le32(int32_t(body.size())) + std::string{char(16), char(31)} + palette;
+  const std::string section = std::string("Body") + std::string(12, '\0') + le32(0) + le32(1) + le32(0);
+  std::string tailer = le32(0) + le32(8) + le32(16) + f32(0.5f);
+  const float m[12] = {1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0};
+  for (float v : m) tailer += f32(v);
+  for (float v : {0.f, 0.f, 0.f, 4.f, 1.f, 6.f}) tailer += f32(v);
+  tailer += std::string{char(2), char(1), char(3), char(2)};
+  return header + section + body + tailer;
+}
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
@@ -62,6 +94,14 @@ TempDir::TempDir() {
 
 TempDir::~TempDir() {
   std::error_code ec;
+  // bench/fuzz seeds its corpora with the files the tests write.
+  if (const char* keep = std::getenv("VOXPRESS_KEEP_TEST_FILES"); keep && *keep) {
+    const std::string prefix = dir_.filename().string().substr(dir_.filename().string().find('-', 14) + 1);
+    for (const auto& e : fs::recursive_directory_iterator(dir_, ec))
+      if (e.is_regular_file(ec) && e.file_size(ec) <= (256u << 10))
+        fs::copy_file(e.path(), fs::path(keep) / (prefix + "-" + e.path().filename().string()),
+                      fs::copy_options::overwrite_existing, ec);
+  }
   fs::remove_all(dir_, ec);
 }
 

@@ -17,7 +17,9 @@
 
 namespace voxpress::test {
 
-/// A fresh, empty folder removed at the end of the test.
+/// A fresh, empty folder removed at the end of the test (its files of up to
+/// 256 KiB are first copied to $VOXPRESS_KEEP_TEST_FILES when that is set:
+/// bench/fuzz's seed corpora).
 class TempDir {
  public:
   TempDir();
@@ -91,6 +93,11 @@ std::string vox_chunk(const std::string& id, const std::string& content, const s
 std::string vox_dict(const std::vector<std::pair<std::string, std::string>>& entries);
 std::string vox_model(std::array<int, 3> size, const std::vector<std::array<uint8_t, 4>>& voxels);
 std::string vox_file(const std::string& main_children, int32_t version = 150);
+
+/// A little-endian float32; a minimal Westwood .vxl: one section "Body" of
+/// 2 x 1 x 3 voxels holding 3 voxels (placement described in test_util.cpp).
+std::string f32(float v);
+std::string vxl_file();
 
 /// Runs the voxpress CLI with `args`; returns the exit code, fills output
 /// with stdout and stderr combined.

@@ -151,5 +151,14 @@ void register_press(CLI::App& app, Global& g);
 void register_press2d(CLI::App& app, Global& g);
 void register_smooth_mesh(CLI::App& app, Global& g);
 void register_voxart(CLI::App& app, Global& g);
+void register_render(CLI::App& app, Global& g);
+void register_report(CLI::App& app, Global& g);
+
+/// Paths the render and report commands accept besides volumes.
+bool is_mesh_path(const std::string& path);       ///< .ply .obj .stl .off (readable meshes)
+bool is_voxel_art_path(const std::string& path);  ///< .vox .vxl
+/// A volume's surface for display: "voxels" (cell faces), "midpoint", or a
+/// press method name with its defaults (throws UsageError otherwise).
+Mesh display_surface(const BinaryVolume& volume, const std::string& method);
 
 }  // namespace voxpress::cli

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   cli::register_press2d(app, g);
   cli::register_smooth_mesh(app, g);
   cli::register_voxart(app, g);
+  cli::register_render(app, g);
+  cli::register_report(app, g);
 
   try {
     app.parse(argc, argv);

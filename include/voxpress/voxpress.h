@@ -15,6 +15,7 @@
 #include "voxpress/io/image_io.h"
 #include "voxpress/io/mesh_io.h"
 #include "voxpress/io/volume_io.h"
+#include "voxpress/render/render.h"
 #include "voxpress/smooth/flats.h"
 #include "voxpress/smooth/pressing.h"
 #include "voxpress/smooth/mesh_smoothing.h"

@@ -2,6 +2,7 @@
 
 #include "voxpress/io/atomic_file.h"
 
+#include <signal.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -212,6 +213,26 @@ int64_t parse_int(const std::string& path, const std::string& text, const std::s
   return v;
 }
 
+namespace {
+
+// A run killed while writing (SIGKILL, power loss) leaves its hidden
+// temporary ".NAME.tmpPID-N.ext" behind, never a partial NAME. The next
+// write of NAME removes those whose process is gone.
+void remove_stale_temporaries(const fs::path& dir, const std::string& prefix) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.starts_with(prefix)) continue;
+    long pid = 0;
+    const char* first = name.data() + prefix.size();
+    const auto [end, err] = std::from_chars(first, name.data() + name.size(), pid);
+    if (err != std::errc() || end == first || *end != '-' || pid <= 0 || pid == long(::getpid())) continue;
+    if (::kill(pid_t(pid), 0) == -1 && errno == ESRCH) fs::remove(e.path(), ec);
+  }
+}
+
+}  // namespace
+
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
   static std::atomic<unsigned> counter{0};
   const fs::path target(path);
@@ -225,6 +246,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
   name.append(target.filename().string()).append(".tmp").append(std::to_string(::getpid()));
   name.append("-").append(std::to_string(counter++)).append(ext);
   const fs::path tmp = dir / name;
+  remove_stale_temporaries(dir, "." + target.filename().string() + ".tmp");
   try {
     write(tmp.string());
     fs::rename(tmp, target, ec);

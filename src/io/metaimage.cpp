@@ -108,7 +108,12 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   if (nd < 2 || nd > 3) throw InputError(path, "MetaImage with NDims = " + std::to_string(nd) + " is not supported");
   const auto ds = numbers(path, *dimsize, "DimSize");
   if (int64_t(ds.size()) != nd) throw InputError(path, "DimSize does not list NDims values");
-  for (int a = 0; a < 3; ++a) v.lattice.dims[size_t(a)] = a < nd ? int64_t(ds[size_t(a)]) : 1;
+  for (int a = 0; a < 3; ++a) {
+    const double d = a < nd ? ds[size_t(a)] : 1;
+    if (!(d >= 1 && d <= 0x1p40) || d != std::floor(d))
+      throw InputError(path, "DimSize values must be whole numbers from 1 to 2^40");
+    v.lattice.dims[size_t(a)] = int64_t(d);
+  }
   if (const auto* ch = get("elementnumberofchannels"); ch && parse_int(path, *ch, "ElementNumberOfChannels") != 1)
     throw InputError(path, "multi-channel MetaImage is not supported");
   v.type = met_type(path, *etype);

@@ -5,12 +5,21 @@
 // are RAS. Data scaling (scl_slope != 0 and not identity) is applied, giving
 // float32 (or float64 for 64-bit input). Only 3-D data (a 4th dimension of 1)
 // is accepted; RGB and complex types are refused.
+//
+// nifti_clib trusts the header: a dim[0] outside 1..7 makes it write past a
+// stack array (found by bench/fuzz, docs/RELIABILITY.md). check_header()
+// therefore validates the fields it indexes or sizes with before the file is
+// handed to it.
 #include <nifti2_io.h>
+#include <zlib.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "formats.h"
 #include "io_util.h"
@@ -63,6 +72,56 @@ int to_datatype(ScalarType t) {
   }
 }
 
+// The first bytes of the file (gunzipped when compressed; gzread passes plain
+// files through).
+std::vector<unsigned char> head_bytes(const std::string& path, size_t n) {
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  std::vector<unsigned char> b(n);
+  const int got = gzread(f, b.data(), unsigned(n));
+  gzclose(f);
+  b.resize(got > 0 ? size_t(got) : 0);
+  return b;
+}
+
+template <class T>
+T field(const std::vector<unsigned char>& b, size_t at, bool swap) {
+  unsigned char raw[sizeof(T)];
+  std::memcpy(raw, b.data() + at, sizeof(T));
+  if (swap) std::reverse(raw, raw + sizeof(T));
+  T v;
+  std::memcpy(&v, raw, sizeof(T));
+  return v;
+}
+
+// Validates what nifti_clib relies on: the header size (and from it the
+// version and byte order), dim[0] in 1..7, positive extents, a known data
+// type and a sane data offset.
+void check_header(const std::string& path) {
+  const auto b = head_bytes(path, 540);
+  if (b.size() < 348) throw InputError(path, "truncated: too small for a NIfTI header");
+  const int32_t size = field<int32_t>(b, 0, false), swapped = field<int32_t>(b, 0, true);
+  const bool swap = size != 348 && size != 540;
+  const int32_t hdr = swap ? swapped : size;
+  if (hdr != 348 && hdr != 540)
+    throw InputError(path, "not a NIfTI file (header size field is " + std::to_string(size) + ", expected 348 or 540)");
+  if (hdr == 540 && b.size() < 540) throw InputError(path, "truncated: too small for a NIfTI-2 header");
+  const bool v2 = hdr == 540;
+  int64_t dim[8];
+  for (int d = 0; d < 8; ++d)
+    dim[d] = v2 ? field<int64_t>(b, 16 + 8 * size_t(d), swap) : field<int16_t>(b, 40 + 2 * size_t(d), swap);
+  if (dim[0] < 1 || dim[0] > 7)
+    throw InputError(path, "invalid NIfTI header: dim[0] is " + std::to_string(dim[0]) + " (must be 1 to 7)");
+  for (int d = 1; d <= dim[0]; ++d)
+    if (dim[d] < 1 || dim[d] > (int64_t(1) << 40))
+      throw InputError(path, "invalid NIfTI header: dim[" + std::to_string(d) + "] is " + std::to_string(dim[d]));
+  const int dt = field<int16_t>(b, v2 ? 12 : 70, swap);
+  (void)from_datatype(path, dt);
+  const double offset = v2 ? double(field<int64_t>(b, 168, swap)) : double(field<float>(b, 108, swap));
+  if (!(offset >= 0 && offset < 0x1p40))
+    throw InputError(path, "invalid NIfTI header: vox_offset is " + std::to_string(offset));
+}
+
 }  // namespace
 
 ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
@@ -70,6 +129,7 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   const uint64_t fsize = file_size(path);
   const std::string ext = extension_of(path);
   if (ext != ".nii.gz" && fsize < 348) throw InputError(path, "truncated: too small for a NIfTI header");
+  check_header(path);
   NimPtr nim(nifti_image_read(path.c_str(), 0));
   if (!nim) throw InputError(path, "not a readable NIfTI-1/2 file (bad or truncated header)");
   ScalarVolume v;

@@ -11,8 +11,10 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 #include "formats.h"
 #include "io_util.h"
@@ -150,7 +152,15 @@ void parse_text(const std::string& path, const std::string& text, ScalarVolume& 
   v.visit([&](auto values) {
     using T = typename decltype(values)::value_type;
     T* out = const_cast<T*>(values.data());
-    while (k < n && in >> tok) out[k++] = T(parse_double(path, tok, "text sample"));
+    while (k < n && in >> tok) {
+      const double x = parse_double(path, tok, "text sample");
+      // The conversion is undefined outside T's range (and for NaN into an integer type).
+      const bool fits = std::is_floating_point_v<T>
+                            ? !std::isfinite(x) || std::abs(x) <= double(std::numeric_limits<T>::max())
+                            : x >= double(std::numeric_limits<T>::lowest()) && x < double(std::numeric_limits<T>::max()) + 1.0;
+      if (!fits) throw InputError(path, "text sample " + tok + " does not fit the declared voxel type");
+      out[k++] = T(x);
+    }
   });
   if (k < n)
     throw InputError(path, "truncated: the text payload holds " + std::to_string(k) + " values but the header declares " +

@@ -113,6 +113,12 @@ class Cursor {
       default: { double v; std::memcpy(&v, b, 8); return v; }
     }
   }
+  /// A list's length: a whole number in [0, limit] (NaN and negatives refused).
+  uint64_t length(PType t, double limit, const std::string& what) {
+    const double n = read(t);
+    if (!(n >= 0 && n <= limit) || n != std::floor(n)) throw InputError(path_, what);
+    return uint64_t(n);
+  }
   uint64_t remaining() const { return uint64_t(end_ - p_); }
   [[noreturn]] void truncated() const { throw InputError(path_, "truncated: the data ends before every element was read"); }
 
@@ -232,7 +238,7 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
         for (size_t k = 0; k < e.props.size(); ++k) {
           const Property& p = e.props[k];
           if (p.list) {
-            const auto n = uint64_t(cur.read(p.count_type));
+            const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'vertex'");
             for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
           } else {
             rec[k] = cur.read(p.type);
@@ -272,9 +278,7 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
         for (size_t k = 0; k < e.props.size(); ++k) {
           const Property& p = e.props[k];
           if (p.list) {
-            const double nd = cur.read(p.count_type);
-            if (nd < 0 || nd > 1e6) throw InputError(path, "face " + std::to_string(f) + " has an invalid vertex count");
-            const auto n = uint64_t(nd);
+            const uint64_t n = cur.length(p.count_type, 1e6, "face " + std::to_string(f) + " has an invalid vertex count");
             for (uint64_t q = 0; q < n; ++q) {
               const double x = cur.read(p.type);
               if (int(k) == idx) {
@@ -307,9 +311,8 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
         for (size_t k = 0; k < e.props.size(); ++k) {
           const Property& p = e.props[k];
           if (p.list) {
-            const double nd = cur.read(p.count_type);
-            if (nd < 0 || nd > 1e9) throw InputError(path, "invalid list length in element 'edge'");
-            for (uint64_t q = 0; q < uint64_t(nd); ++q) cur.read(p.type);
+            const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'edge'");
+            for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
           } else {
             rec[k] = cur.read(p.type);
           }
@@ -324,9 +327,8 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
       for (uint64_t r = 0; r < e.count; ++r)
         for (const Property& p : e.props) {
           if (p.list) {
-            const double nd = cur.read(p.count_type);
-            if (nd < 0 || nd > 1e9) throw InputError(path, "invalid list length in element '" + e.name + "'");
-            for (uint64_t q = 0; q < uint64_t(nd); ++q) cur.read(p.type);
+            const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element '" + e.name + "'");
+            for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
           } else {
             cur.read(p.type);
           }

@@ -89,7 +89,7 @@ PageInfo page_info(const std::string& path, TIFF* t) {
 }
 
 // Decodes the current page into out (width * height samples of p.type).
-void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* out) {
+void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* out, uint64_t max_bytes) {
   const size_t vs = scalar_size(p.type);
   const size_t row_bytes = p.bits == 1 ? (p.width + 7) / 8 : size_t(p.width) * vs;
   auto store_row = [&](const uint8_t* src, uint32_t y, uint32_t x0, uint32_t n) {
@@ -107,7 +107,17 @@ void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* o
     TIFFGetField(t, TIFFTAG_TILEWIDTH, &tw);
     TIFFGetField(t, TIFFTAG_TILELENGTH, &th);
     if (tw == 0 || th == 0) throw InputError(path, "TIFF tile size is zero");
-    std::vector<uint8_t> tile(TIFFTileSize(t));
+    // The tile buffer is sized by the header: a tile larger than both the
+    // image and 1024 x 1024 serves no purpose and would let a tiny file
+    // claim gigabytes (found by bench/fuzz).
+    if ((tw > p.width && tw > 1024) || (th > p.height && th > 1024))
+      throw InputError(path, "TIFF tile " + std::to_string(tw) + " x " + std::to_string(th) +
+                                 " is larger than the image (" + std::to_string(p.width) + " x " +
+                                 std::to_string(p.height) + ")");
+    const tmsize_t tile_bytes = TIFFTileSize(t);
+    if (tile_bytes <= 0) throw InputError(path, "invalid TIFF tile size");
+    check_limit(path, uint64_t(tile_bytes), max_bytes, "a TIFF tile");
+    std::vector<uint8_t> tile(static_cast<size_t>(tile_bytes));
     for (uint32_t y0 = 0; y0 < p.height; y0 += th)
       for (uint32_t x0 = 0; x0 < p.width; x0 += tw) {
         if (TIFFReadTile(t, tile.data(), x0, y0, 0, 0) < 0)
@@ -208,7 +218,7 @@ ScalarVolume read_tiff(const std::string& path, uint64_t max_bytes) {
     if (!TIFFSetDirectory(t.get(), z)) throw InputError(path, "cannot read TIFF page " + std::to_string(z));
     const PageInfo p = page_info(path, t.get());
     if (!(p == first)) throw InputError(path, "TIFF page " + std::to_string(z) + " differs in size or type from page 0");
-    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes);
+    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes, max_bytes);
   }
   return v;
 }
@@ -245,7 +255,7 @@ ScalarVolume read_tiff_folder(const std::string& dir, uint64_t max_bytes) {
     } else if (!(p == first)) {
       throw InputError(path, "slice differs in size or type from " + files[0]);
     }
-    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes);
+    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes, max_bytes);
   }
   return v;
 }

@@ -34,7 +34,7 @@ std::string where(const Vec3& p) { return fmt("(%.9g, %.9g, %.9g)", p.x(), p.y()
 }  // namespace
 
 Vec3 LatticeMesh::midpoint(size_t v) const {
-  Vec3 m(double(lower[v][0]), double(lower[v][1]), double(lower[v][2]));
+  Vec3 m = Vec3(double(lower[v][0]), double(lower[v][1]), double(lower[v][2]));
   m[axis[v]] += 0.5;
   return m;
 }

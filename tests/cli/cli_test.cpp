@@ -1,6 +1,12 @@
 // The voxpress command line: each command works, and each kind of bad input
 // gives one line naming the file, a non-zero exit code and no output file.
 #include <nlohmann/json.hpp>
+#include <poll.h>
+#include <signal.h>
+#include <sys/inotify.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <fstream>
 
@@ -111,6 +117,107 @@ TEST(Cli, LabelsThresholdsAndRawInputs) {
 }
 
 // Each bad input: exit code, one line naming the file and the problem, nothing written.
+// Atomic outputs (issue 11): `voxpress press` killed with SIGKILL while it
+// writes its result leaves no output file; the next run writes it and removes
+// the killed run's hidden temporary. The kill is triggered by the temporary
+// file's creation (inotify), not by a timer.
+TEST(Cli, KilledWhileWritingLeavesNoOutputFile) {
+  test::TempDir tmp;
+  ASSERT_EQ(run_cli("-q generate sphere --res 120 -o " + tmp.path("s.nrrd")), 0);
+  const fs::path out = tmp.dir() / "out";
+  fs::create_directories(out);
+  const std::string target = (out / "s.ply").string();
+  const int watch = inotify_init1(IN_CLOEXEC);
+  ASSERT_GE(watch, 0);
+  ASSERT_GE(inotify_add_watch(watch, out.c_str(), IN_CREATE), 0);
+  const std::string input = tmp.path("s.nrrd");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(VOXPRESS_CLI, "voxpress", "-q", "press", input.c_str(), "-o", target.c_str(), "--no-flats",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const int pidfd = int(syscall(SYS_pidfd_open, pid, 0));
+  bool killed = false;
+  while (!killed) {
+    pollfd fds[2] = {{watch, POLLIN, 0}, {pidfd, POLLIN, 0}};
+    // A guard against a hang only; the test never waits on time otherwise.
+    ASSERT_GT(poll(fds, pidfd >= 0 ? 2 : 1, 600000), 0) << "no output file was ever started";
+    if (fds[0].revents & POLLIN) {
+      alignas(inotify_event) char buf[4096];
+      const ssize_t n = read(watch, buf, sizeof buf);
+      for (ssize_t at = 0; at < n;) {
+        const auto* ev = reinterpret_cast<const inotify_event*>(buf + at);
+        if (ev->len && std::string(ev->name).starts_with(".s.ply.tmp")) killed = kill(pid, SIGKILL) == 0;
+        at += ssize_t(sizeof(inotify_event) + ev->len);
+      }
+    } else if (fds[1].revents & POLLIN) {
+      break;  // the process ended before it started writing
+    }
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  close(watch);
+  if (pidfd >= 0) close(pidfd);
+  ASSERT_TRUE(killed) << "voxpress exited (status " << status << ") before writing";
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "it finished before the kill landed";
+  EXPECT_FALSE(fs::exists(target));
+  // The next run completes; only the finished file remains.
+  ASSERT_EQ(run_cli("-q press " + input + " -o " + target + " --no-flats"), 0);
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(out)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"s.ply"});
+  EXPECT_GT(read_mesh(target).triangles.size(), 1000u);
+}
+
+TEST(Cli, RenderAndReportWritePicturesAndPagesAndRefuseBadInput) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate sphere --res 24 -o " + tmp.path("s.nrrd")), 0);
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("s.nrrd") + " -o " + tmp.path("s.ply")), 0);
+  ASSERT_EQ(run_cli("-q render " + tmp.path("s.nrrd") + " -o " + tmp.path("a.png")), 0);
+  EXPECT_EQ(read_image(tmp.path("a.png")).width, 800);
+  ASSERT_EQ(run_cli("-q render " + tmp.path("s.ply") + " " + tmp.path("s.nrrd") + " -o " + tmp.path("b.png") +
+                    " --size 200x150 --method voxels --view x"),
+            0);
+  const GreyImage b = read_image(tmp.path("b.png"));
+  EXPECT_EQ(b.width, 2 * 200 + 8);
+  EXPECT_EQ(b.height, 150);
+  ASSERT_EQ(run_cli("-q report " + tmp.path("s.nrrd") + " -o " + tmp.path("r.html") + " --samples 5000 --stats-json " +
+                    tmp.path("r.json")),
+            0);
+  const auto j = nlohmann::json::parse(test::read_file(tmp.path("r.json")));
+  ASSERT_EQ(j["methods"].size(), 3u);  // voxels, midpoint, pressing
+  EXPECT_EQ(j["methods"][2]["name"], "pressing");
+  EXPECT_EQ(j["methods"][2]["violations"], 0);
+  EXPECT_LT(j["methods"][2]["error"]["rms"].get<double>(), j["methods"][1]["error"]["rms"].get<double>());
+  const std::string html = test::read_file(tmp.path("r.html"));
+  EXPECT_NE(html.find("id=\"voxpress-scene\""), std::string::npos);
+  EXPECT_EQ(html.find("__VOXPRESS_"), std::string::npos);  // every placeholder filled
+  EXPECT_EQ(html.find("<script src"), std::string::npos);  // self-contained (the browser test checks requests)
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  // Bad usage and bad input: one line, the right code, no output file.
+  struct Bad {
+    std::string args, output, problem;
+    int code;
+  };
+  const Bad cases[] = {
+      {"render " + tmp.path("s.nrrd") + " -o " + tmp.path("c.jpg"), "c.jpg", ".png", 2},
+      {"render " + tmp.path("s.nrrd") + " -o " + tmp.path("c.png") + " --size 10x10", "c.png", "16 to 8192", 2},
+      {"render " + tmp.path("nope.nrrd") + " -o " + tmp.path("c.png"), "c.png", "nope.nrrd", 1},
+      {"report " + tmp.path("s.nrrd") + " -o " + tmp.path("q.html") + " --methods midpoint,magic", "q.html", "magic", 2},
+      {"report " + tmp.path("s.ply") + " -o " + tmp.path("q.html"), "q.html", "s.ply", 1},
+  };
+  for (const Bad& bad : cases) {
+    SCOPED_TRACE(bad.args);
+    EXPECT_EQ(run_cli(bad.args, &out), bad.code) << out;
+    EXPECT_NE(out.find(bad.problem), std::string::npos) << out;
+    EXPECT_EQ(count_lines(out), 1u) << out;
+    EXPECT_FALSE(fs::exists(tmp.path(bad.output)));
+  }
+}
+
 TEST(Cli, BadInputsFailCleanly) {
   test::TempDir tmp;
   std::string out;

@@ -1,4 +1,6 @@
 // smooth_surface: every method from one call, each with what it promises.
+#include <tbb/global_control.h>
+
 #include "test_util.h"
 
 namespace voxpress {
@@ -56,6 +58,37 @@ TEST(Pipeline, RefusesBadOptionsAndEmptyVolumes) {
   EXPECT_THROW(smooth_surface(ball, o), UsageError);
   EXPECT_THROW(parse_method("smooth"), UsageError);
   EXPECT_THROW(smooth_surface(test::make_volume(4, 4, 4)), InputError);
+}
+
+// Deterministic (issue 11): the same bytes for 1 and 4 threads on a spread
+// of the property-test volumes, for the reference method with every stage
+// and for two of the others.
+TEST(Pipeline, SameMeshForOneAndManyThreadsOnThePropertyVolumes) {
+  const auto cases = test::property_volumes();
+  int compared = 0;
+  for (size_t i = 0; i < cases.size(); i += 5) {
+    const test::Case& c = cases[i];
+    for (Method m : {Method::pressing, Method::cesn, Method::diamond}) {
+      SCOPED_TRACE(c.name + " " + method_name(m));
+      auto run = [&](int threads) -> std::optional<Mesh> {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        SurfaceOptions o;
+        o.method = m;
+        try {
+          return smooth_surface(c.volume, o).mesh;
+        } catch (const InputError&) {
+          return std::nullopt;  // empty or full volume: refused the same way each time
+        }
+      };
+      const auto one = run(1), many = run(4);
+      ASSERT_EQ(one.has_value(), many.has_value());
+      if (!one) continue;
+      EXPECT_EQ(one->triangles, many->triangles);
+      EXPECT_EQ(one->positions, many->positions);
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 50);
 }
 
 }  // namespace

@@ -153,41 +153,10 @@ TEST(VoxReader, MalformedFilesGiveOneLineErrors) {
   for (size_t n = 0; n < good.size(); n += 7) expect_input_error(file("cut.vox", good.substr(0, n)), "cut.vox");
 }
 
-std::string f32(float v) {
-  uint32_t b;
-  std::memcpy(&b, &v, 4);
-  return le32(int32_t(b));
-}
-
-// A minimal .vxl: one section of size (2, 1, 3), voxels at (0, 0, 0) colour
-// 5 and (1, 0, 1), (1, 0, 2) colour 9; bounds (0..4, 0..1, 0..6) make the
-// voxels 2 x 1 x 2 units; det 0.5 scales the translation (2, 0, 0).
-std::string vxl_bytes() {
-  std::string spans;
-  const std::string col0 = std::string{char(0), char(1), char(5), char(0), char(1)};           // skip 0, 1 voxel
-  const std::string col1 = std::string{char(1), char(2), char(9), char(0), char(9), char(0), char(2)};  // skip 1, 2 voxels
-  const std::string body = le32(0) + le32(int32_t(col0.size())) +                                  // span starts
-                           le32(int32_t(col0.size()) - 1) + le32(int32_t(col0.size() + col1.size()) - 1) +  // span ends
-                           col0 + col1;
-  std::string palette(768, '\0');
-  palette[15] = char(200);  // colour 5 = (200, 0, 0)
-  palette[27] = char(10);   // colour 9 = (10, 20, 30)
-  palette[28] = char(20);
-  palette[29] = char(30);
-  std::string header = std::string("Voxel Animation") + '\0' + le32(1) + le32(1) + le32(1) + le32(int32_t(body.size())) +
-                       std::string{char(16), char(31)} + palette;
-  std::string section = std::string("Body") + std::string(12, '\0') + le32(0) + le32(1) + le32(0);
-  std::string tailer = le32(0) + le32(8) + le32(16) + f32(0.5f);
-  const float m[12] = {1, 0, 0, 2, 0, 1, 0, 0, 0, 0, 1, 0};
-  for (float v : m) tailer += f32(v);
-  for (float v : {0.f, 0.f, 0.f, 4.f, 1.f, 6.f}) tailer += f32(v);
-  tailer += std::string{char(2), char(1), char(3), char(2)};
-  return header + section + body + tailer;
-}
 
 TEST(VxlReader, SectionsSpansPaletteAndPlacement) {
   test::TempDir dir;
-  test::write_file(dir.path("u.vxl"), vxl_bytes());
+  test::write_file(dir.path("u.vxl"), test::vxl_file());
   const VoxelArt art = read_voxel_art(dir.path("u.vxl"));
   ASSERT_EQ(art.parts.size(), 1u);
   const ColorGrid& g = art.parts[0];
@@ -200,7 +169,7 @@ TEST(VxlReader, SectionsSpansPaletteAndPlacement) {
   // Corner (1, 1, 1) -> bounds min + (2, 1, 2) + det * translation (1, 0, 0).
   EXPECT_TRUE((g.linear * Vec3(1, 1, 1) + g.offset).isApprox(Vec3(3, 1, 2)));
   // Every truncation is refused.
-  const std::string good = vxl_bytes();
+  const std::string good = test::vxl_file();
   for (size_t n = 0; n < good.size(); n += 5) {
     test::write_file(dir.path("cut.vxl"), good.substr(0, n));
     expect_input_error(dir.path("cut.vxl"), "cut.vxl");
@@ -209,11 +178,11 @@ TEST(VxlReader, SectionsSpansPaletteAndPlacement) {
 
 TEST(VxlReader, HvaFrameOverridesTheTailerTransform) {
   test::TempDir dir;
-  test::write_file(dir.path("u.vxl"), vxl_bytes());
+  test::write_file(dir.path("u.vxl"), test::vxl_file());
   std::string hva = std::string("u") + std::string(15, '\0') + le32(2) + le32(1) + std::string("Body") + std::string(12, '\0');
   for (float t : {0.f, 8.f}) {
     const float m[12] = {1, 0, 0, t, 0, 1, 0, 0, 0, 0, 1, 0};
-    for (float v : m) hva += f32(v);
+    for (float v : m) hva += test::f32(v);
   }
   test::write_file(dir.path("u.hva"), hva);
   VoxelArtReadOptions o;

@@ -1,0 +1,110 @@
+// voxpress render IN... -o OUT.png: pictures without a GPU (software
+// rasterizer, flat shading). Several inputs are drawn side by side with the
+// same camera; a volume is drawn as the surface of --method.
+#include <cstdio>
+
+#include "common.h"
+#include "voxpress/render/render.h"
+
+namespace voxpress::cli {
+
+bool is_mesh_path(const std::string& path) {
+  try {
+    const MeshFormat f = mesh_format_from_path(path);
+    return f != MeshFormat::gltf && f != MeshFormat::glb;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+bool is_voxel_art_path(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  return ext == ".vox" || ext == ".vxl";
+}
+
+Mesh display_surface(const BinaryVolume& volume, const std::string& method) {
+  if (method == "voxels") return voxel_faces(volume);
+  if (method == "midpoint") return to_mesh(extract_sticks(volume));
+  SurfaceOptions o;
+  o.method = parse_method(method);
+  return smooth_surface(volume, o).mesh;
+}
+
+namespace {
+
+struct RenderCmd {
+  std::vector<std::string> inputs;
+  std::string output, view = "iso", size = "800x600", color = "auto", method = "pressing";
+  bool no_features = false;
+  InputOptions in;
+};
+
+void run_render(const RenderCmd& c, const Global& g) {
+  if (!c.output.ends_with(".png")) throw UsageError("render writes a .png picture, not '" + c.output + "'");
+  RenderOptions o;
+  o.view = parse_view(c.view);
+  int w = 0, h = 0;
+  char extra = 0;
+  if (std::sscanf(c.size.c_str(), "%dx%d%c", &w, &h, &extra) != 2) throw UsageError("--size must be WxH, e.g. 800x600");
+  o.width = w, o.height = h;
+  if (c.color == "regions")
+    o.coloring = Coloring::regions;
+  else if (c.color == "plain")
+    o.coloring = Coloring::plain;
+  else if (c.color != "auto")
+    throw UsageError("--color must be auto, regions or plain");
+  o.features = !c.no_features;
+  std::vector<Texture> pictures;
+  for (const std::string& path : c.inputs) {
+    Mesh mesh;
+    if (is_mesh_path(path)) {
+      MeshReadOptions ro;
+      ro.max_bytes = g.memory_limit();
+      mesh = read_mesh(path, ro);
+    } else if (is_voxel_art_path(path)) {
+      VoxelArtReadOptions ro;
+      ro.max_bytes = g.memory_limit();
+      VoxartOptions vo;
+      vo.y_up = false;  // the render camera is Z-up
+      mesh = polygonize_voxel_art(read_voxel_art(path, ro), vo).mesh;
+    } else {
+      mesh = display_surface(load_binary(path, c.in, g), c.method);
+    }
+    if (mesh.triangles.empty()) throw InputError(path, "has no triangles to draw");
+    pictures.push_back(render_mesh(mesh, o));
+  }
+  const Texture picture = pictures.size() == 1 ? pictures[0] : side_by_side(pictures);
+  write_png(c.output, picture.width, picture.height, picture.rgba);
+  if (!g.quiet)
+    std::fprintf(stderr, "%s: %lld x %lld picture of %zu input(s)\n", c.output.c_str(), (long long)picture.width,
+                 (long long)picture.height, c.inputs.size());
+}
+
+}  // namespace
+
+void register_render(CLI::App& app, Global& g) {
+  auto c = std::make_shared<RenderCmd>();
+  auto* cmd = app.add_subcommand("render",
+                                 "Draw meshes, volumes or voxel art to a PNG without a GPU (flat shading; several "
+                                 "inputs side by side, same camera)");
+  cmd->add_option("inputs", c->inputs, "Meshes (.ply .obj .stl .off), volumes, or voxel art (.vox .vxl)")
+      ->required();
+  cmd->add_option("-o,--output", c->output, "Output picture (.png)")->required();
+  cmd->add_option("--view", c->view, "iso, x, y or z (looking along -x, +y, -z)")->capture_default_str();
+  cmd->add_option("--size", c->size, "Size of each picture, WxH pixels")->capture_default_str();
+  cmd->add_option("--color", c->color, "auto (texture / vertex colours), regions (one colour per flat, curved grey), "
+                                       "plain")
+      ->capture_default_str();
+  cmd->add_option("--method", c->method, "For volumes: voxels, midpoint, or a press method (pressing, cesn, diamond, "
+                                         "...)")
+      ->capture_default_str();
+  cmd->add_flag("--no-features", c->no_features, "Do not draw the sharp feature curves");
+  c->in.bind(*cmd);
+  cmd->callback([c, &g] {
+    g.apply();
+    run_render(*c, g);
+  });
+}
+
+}  // namespace voxpress::cli
