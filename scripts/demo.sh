@@ -27,6 +27,9 @@ echo "== without the volume: the midpoint STL smoothed inside Bade's diamonds, t
 "$vp" -q extract "$out/part.nrrd" -o "$out/part-midpoint.stl"
 "$vp" smooth-mesh "$out/part-midpoint.stl" -o "$out/part-diamond.ply" --constraint diamond
 "$vp" check "$out/part-diamond.ply" --volume "$out/part.nrrd"
+echo "== pictures: a PNG drawn without a GPU, and the interactive report (open it in a browser)"
+"$vp" render "$out/part-midpoint.ply" "$out/part-pressed.ply" --color regions --size 480x400 -o "$out/part.png"
+"$vp" report "$out/part.nrrd" -o "$out/report.html" --methods midpoint,pressing,cesn --stats-json "$out/report.json"
 echo "== 2D: the contours of a small binary image, pressed"
 "$vp" press2d "$root/examples/shapes.pbm" -o "$out/shapes.svg" --midpoint
-echo "== wrote $out/: part.nrrd, part-midpoint.ply, part-noflats.ply, part-pressed.ply/.glb (vertex colours = flats), part-diamond.ply, press.json, eval-*.json, shapes.svg"
+echo "== wrote $out/: part.nrrd, part-midpoint.ply, part-noflats.ply, part-pressed.ply/.glb (vertex colours = flats), part-diamond.ply, part.png, report.html, press.json, report.json, eval-*.json, shapes.svg"

@@ -2,6 +2,7 @@
 // rasterizer, flat shading). Several inputs are drawn side by side with the
 // same camera; a volume is drawn as the surface of --method.
 #include <cstdio>
+#include <sstream>
 
 #include "common.h"
 #include "voxpress/render/render.h"
@@ -35,7 +36,7 @@ namespace {
 
 struct RenderCmd {
   std::vector<std::string> inputs;
-  std::string output, view = "iso", size = "800x600", color = "auto", method = "pressing";
+  std::string output, view = "iso", size = "800x600", color = "auto", method;
   bool no_features = false;
   InputOptions in;
 };
@@ -55,8 +56,20 @@ void run_render(const RenderCmd& c, const Global& g) {
   else if (c.color != "auto")
     throw UsageError("--color must be auto, regions or plain");
   o.features = !c.no_features;
+  // One method for every input, or one per input.
+  std::vector<std::string> methods;
+  {
+    std::stringstream ss(c.method);
+    for (std::string m; std::getline(ss, m, ',');) methods.push_back(m);
+  }
+  if (methods.size() > 1 && methods.size() != c.inputs.size())
+    throw UsageError("--method lists " + std::to_string(methods.size()) + " methods for " +
+                     std::to_string(c.inputs.size()) + " inputs (give one, or one per input)");
+  std::vector<Mesh> meshes;
   std::vector<Texture> pictures;
-  for (const std::string& path : c.inputs) {
+  for (size_t i = 0; i < c.inputs.size(); ++i) {
+    const std::string& path = c.inputs[i];
+    const std::string method = methods.empty() ? "" : methods.size() == 1 ? methods[0] : methods[i];
     Mesh mesh;
     if (is_mesh_path(path)) {
       MeshReadOptions ro;
@@ -67,13 +80,18 @@ void run_render(const RenderCmd& c, const Global& g) {
       ro.max_bytes = g.memory_limit();
       VoxartOptions vo;
       vo.y_up = false;  // the render camera is Z-up
+      vo.fairing = parse_voxart_fairing(method.empty() ? "lanczos" : method == "voxels" ? "none" : method);
       mesh = polygonize_voxel_art(read_voxel_art(path, ro), vo).mesh;
     } else {
-      mesh = display_surface(load_binary(path, c.in, g), c.method);
+      mesh = display_surface(load_binary(path, c.in, g), method.empty() ? "pressing" : method);
     }
     if (mesh.triangles.empty()) throw InputError(path, "has no triangles to draw");
-    pictures.push_back(render_mesh(mesh, o));
+    meshes.push_back(std::move(mesh));
   }
+  // Several inputs share one scale: each picture frames every input's vertices.
+  if (meshes.size() > 1)
+    for (const Mesh& m : meshes) o.frame.insert(o.frame.end(), m.positions.begin(), m.positions.end());
+  for (const Mesh& m : meshes) pictures.push_back(render_mesh(m, o));
   const Texture picture = pictures.size() == 1 ? pictures[0] : side_by_side(pictures);
   write_png(c.output, picture.width, picture.height, picture.rgba);
   if (!g.quiet)
@@ -96,9 +114,9 @@ void register_render(CLI::App& app, Global& g) {
   cmd->add_option("--color", c->color, "auto (texture / vertex colours), regions (one colour per flat, curved grey), "
                                        "plain")
       ->capture_default_str();
-  cmd->add_option("--method", c->method, "For volumes: voxels, midpoint, or a press method (pressing, cesn, diamond, "
-                                         "...)")
-      ->capture_default_str();
+  cmd->add_option("--method", c->method,
+                  "One for all inputs or one per input (comma-separated). Volumes: voxels, midpoint, or a press "
+                  "method (default pressing); voxel art: voxels, lanczos (default), taubin, pressing");
   cmd->add_flag("--no-features", c->no_features, "Do not draw the sharp feature curves");
   c->in.bind(*cmd);
   cmd->callback([c, &g] {

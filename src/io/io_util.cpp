@@ -57,6 +57,8 @@ uint64_t file_size(const std::string& path) {
   const auto status = fs::status(path, ec);
   if (ec || !fs::exists(status)) throw InputError(path, "no such file");
   if (fs::is_directory(status)) throw InputError(path, "is a directory, not a file");
+  // A pipe or device (data file: /dev/stdin, /dev/zero) could block or never end.
+  if (!fs::is_regular_file(status)) throw InputError(path, "is not a regular file (a device, pipe or socket)");
   const auto size = fs::file_size(path, ec);
   if (ec) throw InputError(path, "cannot read: " + ec.message());
   return size;
@@ -246,7 +248,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
   name.append(target.filename().string()).append(".tmp").append(std::to_string(::getpid()));
   name.append("-").append(std::to_string(counter++)).append(ext);
   const fs::path tmp = dir / name;
-  remove_stale_temporaries(dir, "." + target.filename().string() + ".tmp");
+  remove_stale_temporaries(dir, std::string(".").append(target.filename().string()).append(".tmp"));
   try {
     write(tmp.string());
     fs::rename(tmp, target, ec);

@@ -94,11 +94,12 @@ Texture render_mesh(const Mesh& mesh, const RenderOptions& o) {
   const Camera cam = camera_for(o.view);
   // Fit the projected bounding rectangle with a 4 % margin.
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0, z0 = x0, z1 = -x0;
-  for (const Vec3& p : mesh.positions) {
+  auto extend = [&](const Vec3& p) {
     x0 = std::min(x0, cam.right.dot(p)), x1 = std::max(x1, cam.right.dot(p));
     y0 = std::min(y0, cam.up.dot(p)), y1 = std::max(y1, cam.up.dot(p));
     z0 = std::min(z0, cam.eye.dot(p)), z1 = std::max(z1, cam.eye.dot(p));
-  }
+  };
+  for (const Vec3& p : o.frame.empty() ? mesh.positions : o.frame) extend(p);
   Texture out;
   out.width = o.width, out.height = o.height;
   out.rgba.assign(size_t(o.width * o.height) * 4, 255);
@@ -114,9 +115,11 @@ Texture render_mesh(const Mesh& mesh, const RenderOptions& o) {
     const Vec3 light = (cam.eye + 0.7 * cam.up + 0.35 * cam.right).normalized();
     const MeshAttribute* face_reg = mesh.face_attribute("region");
     const MeshAttribute* vert_reg = mesh.vertex_attribute("region");
-    const bool textured = o.coloring == Coloring::automatic && !mesh.texture.empty() &&
+    // Region colours need regions; a mesh without them is drawn as usual.
+    const Coloring coloring = o.coloring == Coloring::regions && !face_reg && !vert_reg ? Coloring::automatic : o.coloring;
+    const bool textured = coloring == Coloring::automatic && !mesh.texture.empty() &&
                           mesh.uvs.size() == mesh.positions.size();
-    const bool vcolors = o.coloring == Coloring::automatic && !textured && mesh.colors.size() == mesh.positions.size();
+    const bool vcolors = coloring == Coloring::automatic && !textured && mesh.colors.size() == mesh.positions.size();
     const Rgb base = rgb(o.base), curved = {205, 205, 205};
 
     for (size_t f = 0; f < mesh.triangles.size(); ++f) {
@@ -131,7 +134,7 @@ Texture render_mesh(const Mesh& mesh, const RenderOptions& o) {
       if (n.dot(cam.eye) < 0) n = -n, dim = 0.6;  // an inner side seen through an opening
       const double shade = dim * (0.34 + 0.46 * std::max(0.0, n.dot(light)) + 0.24 * std::max(0.0, n.dot(cam.eye)));
       Rgb face_color = base;
-      if (o.coloring == Coloring::regions) {
+      if (coloring == Coloring::regions) {
         const int64_t r = face_region(mesh, face_reg, vert_reg, f);
         face_color = r >= 0 ? rgb(region_color(r)) : curved;
       }

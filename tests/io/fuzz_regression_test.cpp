@@ -97,5 +97,25 @@ TEST(FuzzRegressions, EveryFindingIsRefusedWithOneLineNamingTheFile) {
   }
 }
 
+// Detached data that is not a regular file (a pipe, a device) could block
+// or never end: refused by name before anything is read.
+TEST(Hardening, DetachedDataMustBeARegularFile) {
+  test::TempDir tmp;
+  const std::pair<const char*, std::string> headers[] = {
+      {"stdin.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: raw\ndata file: /dev/stdin\n\n"},
+      {"zero.mhd", "ObjectType = Image\nNDims = 3\nDimSize = 4 4 4\nElementType = MET_UCHAR\n"
+                   "ElementDataFile = /dev/zero\n"},
+  };
+  for (const auto& [name, text] : headers) {
+    test::write_file(tmp.path(name), text);
+    try {
+      (void)read_volume(tmp.path(name));
+      ADD_FAILURE() << name << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace voxpress

@@ -24,7 +24,7 @@ View parse_view(const std::string& name);
 
 enum class Coloring {
   automatic,  ///< texture if present, else vertex colours, else the base colour
-  regions,    ///< the vertex attribute "region" (flat id >= 0; curved = grey)
+  regions,    ///< the face (else vertex) attribute "region" (flat id >= 0; curved = grey); as automatic without one
   plain,      ///< the base colour only
 };
 
@@ -36,6 +36,9 @@ struct RenderOptions {
   int supersample = 3;   ///< samples per pixel along each axis
   std::array<uint8_t, 3> base{190, 198, 215};
   std::array<uint8_t, 3> background{255, 255, 255};
+  /// Points to frame instead of the mesh's own vertices (pictures of several
+  /// meshes drawn to one scale: all their vertices).
+  std::vector<Vec3> frame;
 };
 
 /// Renders the mesh (physical units) filling the picture; returns RGBA rows

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# scripts/pictures.sh — regenerates the README's pictures (docs/images/*.png)
+# with voxpress's own commands. The CAD part is built in; the medical and
+# voxel-art pictures need ../shared/data (skipped with a message without it).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+"$root/scripts/setup.sh" >&2
+vp="$root/build/bin/voxpress"
+img="$root/docs/images"
+shared="$root/../shared/data"
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+mkdir -p "$img"
+
+# A rotated CAD-like part at 128^3: midpoint surface vs Pressing (flats coloured, sharp edges drawn).
+"$vp" -q generate cad-part --res 128 --rotate random:7 -o "$work/part.nrrd"
+"$vp" -q extract "$work/part.nrrd" -o "$work/part-midpoint.ply"
+"$vp" -q press "$work/part.nrrd" -o "$work/part-pressed.ply"
+"$vp" render "$work/part-midpoint.ply" "$work/part-pressed.ply" --color regions --size 480x400 -o "$img/cad-part.png"
+
+if [ -d "$shared/medical" ]; then
+  # A CT segmentation (TotalSegmentator's aorta, 1.5 mm): input voxels vs Pressing.
+  "$vp" render "$shared/medical/totalseg_aorta.nii.gz" "$shared/medical/totalseg_aorta.nii.gz" \
+    --method voxels,pressing --view y --size 360x460 -o "$img/aorta.png"
+  # MagicaVoxel's chr_knight: the voxels vs the faired, textured mesh (voxpress voxart).
+  "$vp" render "$shared/vox/chr_knight.vox" "$shared/vox/chr_knight.vox" --method voxels,lanczos \
+    --size 400x440 -o "$img/voxel-art.png"
+else
+  echo "pictures: ../shared/data is absent; the medical and voxel-art pictures were not regenerated" >&2
+fi
