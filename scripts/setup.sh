@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # scripts/setup.sh [--tests] — installs what voxpress needs on Debian 12 (only
 # the packages that are missing) and builds it in Release under build/
-# (library, CLI, benchmarks, tests and the Python module in build/python).
+# (library, CLI, benchmarks, tests and the Python module in build/python;
+# with --tests, everything but the benchmarks).
 # The report viewer's packages (three.js, meshoptimizer, esbuild) come from
 # npm (web/package-lock.json); --tests also installs the Node packages and
 # the Chromium the test suite uses.
@@ -39,5 +40,8 @@ if [ $with_tests = 1 ]; then
     echo "setup: npm ci failed; the glTF validator and browser tests will be skipped" >&2
 fi
 
-cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release ${VOXPRESS_CMAKE_ARGS:-} >/dev/null
+# The test command skips the benchmark programs (no test uses them; CI time).
+bench=ON; [ $with_tests = 1 ] && bench=OFF
+cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DVOXPRESS_BUILD_BENCH=$bench \
+  ${VOXPRESS_CMAKE_ARGS:-} >/dev/null
 cmake --build "$root/build" -j "$(nproc)" >&2

@@ -61,6 +61,14 @@ std::vector<Finding> findings() {
            "8e8e8e8e8e8e8e8e8e8e8e8e8e8e8e8e8e8e8ee592e2626110606066800016280de33341294602347ef0c19e5c5a01e600307880263f"
            "3801716182171c40e5aa38403803000b7356f750020000"),
        "dim[0]"},
+      // Timeout: an element without properties and a count of 6.6e8 looped
+      // over empty records (0.6 s in Release, over 10 s under ASan); with
+      // 2^63, as here, it would never end (a regression hangs until ctest's
+      // timeout fails it).
+      {"empty-elements.ply",
+       "ply\nformat binary_little_endian 1.0\nelement junk 9223372036854775807\nelement edge 9223372036854775807\n"
+       "end_header\n",
+       "no vertex element"},
       // UBSan: a DimSize beyond int64 converted to an integer (metaimage.cpp).
       {"huge-dimsize.mha",
        "ObjectType = Image\nNDims = 3\nDimSize = 3 5 46666666666666666666666666\nElementType = MET_CHAR\n"

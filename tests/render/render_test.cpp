@@ -101,7 +101,9 @@ TEST(Render, ColoursRegionsTexturesAndFeatures) {
   EXPECT_LT(top[2], 30);
   EXPECT_GT(bottom[2], 150);
   EXPECT_LT(bottom[0], 30);
-  EXPECT_THROW(render_mesh(quad, RenderOptions{.width = 8}), UsageError);
+  RenderOptions tiny;
+  tiny.width = 8;
+  EXPECT_THROW(render_mesh(quad, tiny), UsageError);
   EXPECT_THROW(parse_view("top"), UsageError);
 }
 
