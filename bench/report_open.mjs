@@ -29,7 +29,7 @@ try {
   if (!browser) {
     console.log('Chromium or playwright-core missing: open time not measured');
   } else {
-    for (let run = 1; run <= 3; run++) {
+    for (let run = 1; run <= 5; run++) {
       const { page, ms } = await openReport(browser, html);
       const t = await page.evaluate(() => window.voxpressReport.ms);
       console.log(`open + decode + first frame, run ${run}: ${ms.toFixed(0)} ms (page: parse and scripts ` +
