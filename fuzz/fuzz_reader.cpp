@@ -53,6 +53,14 @@ const fs::path& folder() {
     fs::create_directories(d);
     return d;
   }();
+  static const bool cleanup = [] {
+    // Removed at a normal exit; bench/fuzz sweeps what crashed processes leave.
+    return std::atexit([] {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }) == 0;
+  }();
+  (void)cleanup;
   return dir;
 }
 
