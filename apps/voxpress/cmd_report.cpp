@@ -196,8 +196,10 @@ void run_report(const ReportCmd& c, const Global& g) {
   if (!c.truth.empty() || !raw.metadata.empty()) {
     try {
       truth = resolve_truth(c.truth, &raw);
-    } catch (const UsageError&) {
-      if (!c.truth.empty()) throw;  // asked for and not resolvable; otherwise simply no heat map
+    } catch (const Error&) {
+      // Asked for and not resolvable: an error. Otherwise (metadata without a
+      // usable truth, e.g. a voxelized model whose mesh moved) just no heat map.
+      if (!c.truth.empty()) throw;
     }
   }
   const double voxel = volume.lattice.spacing.minCoeff();
