@@ -36,25 +36,6 @@ struct ReportCmd {
   InputOptions in;
 };
 
-std::string base64(const std::vector<uint8_t>& data) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((data.size() + 2) / 3 * 4);
-  size_t i = 0;
-  for (; i + 2 < data.size(); i += 3) {
-    const uint32_t v = uint32_t(data[i]) << 16 | uint32_t(data[i + 1]) << 8 | data[i + 2];
-    for (int s = 18; s >= 0; s -= 6) out.push_back(table[(v >> s) & 63]);
-  }
-  if (i < data.size()) {
-    const uint32_t v = uint32_t(data[i]) << 16 | (i + 1 < data.size() ? uint32_t(data[i + 1]) << 8 : 0);
-    out.push_back(table[(v >> 18) & 63]);
-    out.push_back(table[(v >> 12) & 63]);
-    out.push_back(i + 1 < data.size() ? table[(v >> 6) & 63] : '=');
-    out.push_back('=');
-  }
-  return out;
-}
-
 // Appends a meshoptimizer-encoded vertex stream; returns its [offset, size].
 nlohmann::json append_vertices(std::vector<uint8_t>& blob, const void* data, size_t count, size_t stride) {
   std::vector<uint8_t> enc(meshopt_encodeVertexBufferBound(count, stride));

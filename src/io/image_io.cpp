@@ -128,6 +128,8 @@ GreyImage read_netpbm(const std::string& path, uint64_t max_bytes) {
   return g;
 }
 
+}  // namespace
+
 std::string base64(const std::vector<uint8_t>& in) {
   static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -142,8 +144,6 @@ std::string base64(const std::vector<uint8_t>& in) {
   }
   return out;
 }
-
-}  // namespace
 
 GreyImage read_image(const std::string& path, uint64_t max_bytes) {
   const uint64_t cap = max_bytes ? max_bytes : default_memory_limit();

@@ -26,6 +26,9 @@ GreyImage read_image(const std::string& path, uint64_t max_bytes = 0);
 void write_png(const std::string& path, int64_t width, int64_t height, const std::vector<uint8_t>& rgba);
 /// Encodes an 8-bit RGBA PNG in memory.
 std::vector<uint8_t> encode_png(int64_t width, int64_t height, const std::vector<uint8_t>& rgba);
+/// Standard base64 (with '=' padding), for data embedded in text formats
+/// (the SVG's pixels, the HTML report's meshes).
+std::string base64(const std::vector<uint8_t>& data);
 
 struct SvgOptions {
   bool pixels = true;     ///< draw the inside pixels underneath (embedded PNG)
