@@ -1,6 +1,7 @@
 // Shared helpers of the readers and writers (private).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -40,6 +41,10 @@ std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzi
 
 /// Reverses the byte order of `count` values of `width` bytes in place.
 void swap_bytes(std::byte* data, uint64_t count, size_t width);
+
+/// A whole number in [lo, hi]: what a count or an index read as a double
+/// must be before it is converted to an integer (NaN never is).
+inline bool whole_in(double x, double lo, double hi) { return x >= lo && x <= hi && x == std::floor(x); }
 
 /// Throws LimitError(path, ...) if `bytes` exceeds the cap (0 = no cap).
 void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);

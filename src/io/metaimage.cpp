@@ -110,7 +110,7 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   if (int64_t(ds.size()) != nd) throw InputError(path, "DimSize does not list NDims values");
   for (int a = 0; a < 3; ++a) {
     const double d = a < nd ? ds[size_t(a)] : 1;
-    if (!(d >= 1 && d <= 0x1p40) || d != std::floor(d))
+    if (!whole_in(d, 1, 0x1p40))
       throw InputError(path, "DimSize values must be whole numbers from 1 to 2^40");
     v.lattice.dims[size_t(a)] = int64_t(d);
   }

@@ -116,7 +116,7 @@ class Cursor {
   /// A list's length: a whole number in [0, limit] (NaN and negatives refused).
   uint64_t length(PType t, double limit, const std::string& what) {
     const double n = read(t);
-    if (!(n >= 0 && n <= limit) || n != std::floor(n)) throw InputError(path_, what);
+    if (!whole_in(n, 0, limit)) throw InputError(path_, what);
     return uint64_t(n);
   }
   uint64_t remaining() const { return uint64_t(end_ - p_); }
@@ -286,7 +286,7 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
             for (uint64_t q = 0; q < n; ++q) {
               const double x = cur.read(p.type);
               if (int(k) == idx) {
-                if (x < 0 || x >= 4294967295.0 || x != std::floor(x))
+                if (!whole_in(x, 0, 4294967294.0))
                   throw InputError(path, "face " + std::to_string(f) + " has an invalid vertex index");
                 poly.push_back(uint32_t(x));
               }
@@ -323,7 +323,7 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
         }
         if (i1 < 0 || i2 < 0) continue;
         const double a = rec[size_t(i1)], b = rec[size_t(i2)];
-        if (a < 0 || b < 0 || a >= 4294967295.0 || b >= 4294967295.0 || a != std::floor(a) || b != std::floor(b))
+        if (!whole_in(a, 0, 4294967294.0) || !whole_in(b, 0, 4294967294.0))
           throw InputError(path, "edge " + std::to_string(r) + " has an invalid vertex index");
         m.edges.push_back({uint32_t(a), uint32_t(b)});
       }

@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "formats.h"
@@ -203,7 +204,8 @@ Mesh read_off(const std::string& path, uint64_t max_bytes) {
   Tokens counts(path, count_text.data(), count_text.data() + count_text.size());
   const double nv = counts.number("vertex count");
   const double nf = counts.number("face count");
-  if (nv < 0 || nf < 0 || nv != std::floor(nv) || nf != std::floor(nf)) throw InputError(path, "invalid OFF counts");
+  const double any = std::numeric_limits<double>::infinity();
+  if (!whole_in(nv, 0, any) || !whole_in(nf, 0, any)) throw InputError(path, "invalid OFF counts");
   if (nv * 6 > double(end - p) + 6 || nf * 6 > double(end - p) + 6)
     throw InputError(path, "truncated: the OFF counts exceed what the file can hold");
   check_limit(path, uint64_t(nv) * 48 + uint64_t(nf) * 12, max_bytes, "the mesh");
@@ -220,11 +222,11 @@ Mesh read_off(const std::string& path, uint64_t max_bytes) {
     if (!next_line(line)) throw InputError(path, "truncated: fewer faces than the header declares");
     Tokens lt(path, line.data(), line.data() + line.size());
     const double n = lt.number("face size");
-    if (n < 3 || n > 1e6 || n != std::floor(n)) throw InputError(path, "face " + std::to_string(f) + " has an invalid size");
+    if (!whole_in(n, 3, 1e6)) throw InputError(path, "face " + std::to_string(f) + " has an invalid size");
     poly.resize(size_t(n));
     for (auto& i : poly) {
       const double x = lt.number("vertex index");
-      if (x < 0 || x >= nv || x != std::floor(x))
+      if (!whole_in(x, 0, nv - 1))
         throw InputError(path, "face " + std::to_string(f) + " uses vertex " + format_double(x) + " but there are " +
                                    format_double(nv) + " vertices");
       i = uint32_t(x);
