@@ -24,12 +24,15 @@ bool is_voxel_art_path(const std::string& path) {
   return ext == ".vox" || ext == ".vxl";
 }
 
-Mesh display_surface(const BinaryVolume& volume, const std::string& method) {
+Mesh display_surface(const BinaryVolume& volume, const std::string& method, SurfaceResult* result) {
   if (method == "voxels") return voxel_faces(volume);
   if (method == "midpoint") return to_mesh(extract_sticks(volume));
   SurfaceOptions o;
   o.method = parse_method(method);
-  return smooth_surface(volume, o).mesh;
+  SurfaceResult r = smooth_surface(volume, o);
+  Mesh mesh = std::move(r.mesh);
+  if (result) *result = std::move(r);
+  return mesh;
 }
 
 namespace {

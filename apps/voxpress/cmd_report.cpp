@@ -191,32 +191,28 @@ void run_report(const ReportCmd& c, const Global& g) {
     nlohmann::json stats;
   };
   std::vector<Entry> entries;
-  {
-    Stopwatch clock;
-    Mesh vox = voxel_faces(volume);
-    entries.push_back({"voxels", std::move(vox), {{"seconds", clock.seconds()}}});
-  }
+  methods.insert(methods.begin(), "voxels");
   for (const std::string& m : methods) {
     Stopwatch clock;
     nlohmann::json s;
-    Mesh mesh;
-    if (m == "midpoint") {
-      mesh = to_mesh(extract_sticks(volume));
-    } else {
-      SurfaceOptions o;
-      o.method = parse_method(m);
-      SurfaceResult r = smooth_surface(volume, o);
-      mesh = std::move(r.mesh);
-      if (o.method == Method::pressing) {
+    SurfaceResult r;
+    Mesh mesh = display_surface(volume, m, &r);
+    s["seconds"] = clock.seconds();
+    if (m == "voxels") {
+      entries.push_back({m, std::move(mesh), s});
+      continue;
+    }
+    if (m != "midpoint") {
+      const Method method = parse_method(m);
+      if (method == Method::pressing) {
         s["iterations"] = r.press.iterations;
         s["flats"] = r.flats.flats.size();
-      } else if (o.method == Method::cesn) {
+      } else if (method == Method::cesn) {
         s["iterations"] = r.net.iterations;
       } else {
         s["iterations"] = r.smooth.iterations;
       }
     }
-    s["seconds"] = clock.seconds();
     s["violations"] = check_classification(mesh, volume).violations;
     entries.push_back({m, std::move(mesh), s});
   }

@@ -158,7 +158,8 @@ void register_report(CLI::App& app, Global& g);
 bool is_mesh_path(const std::string& path);       ///< .ply .obj .stl .off (readable meshes)
 bool is_voxel_art_path(const std::string& path);  ///< .vox .vxl
 /// A volume's surface for display: "voxels" (cell faces), "midpoint", or a
-/// press method name with its defaults (throws UsageError otherwise).
-Mesh display_surface(const BinaryVolume& volume, const std::string& method);
+/// press method name with its defaults (throws UsageError otherwise). For a
+/// press method, `result` (when given) receives its stats (mesh moved out).
+Mesh display_surface(const BinaryVolume& volume, const std::string& method, SurfaceResult* result = nullptr);
 
 }  // namespace voxpress::cli
