@@ -54,26 +54,74 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
   apply_flats(tiles, seg);
   const double with_tiles = stick_rms(tiles, *c.truth, c.volume);
   if (split) {
-    // Stick error split by vertex class: frozen, junction, fresh.
-    double sum[3] = {0, 0, 0};
-    size_t cnt[3] = {0, 0, 0};
+    // Where the stick error sits: by vertex class (frozen / junction /
+    // fresh) for "+ tiles" and the final surface; the final error by
+    // distance to the nearest true sharp edge (dihedral > 30 degrees); and
+    // per flat, with the distance of its vertices to the truth.
     const Lattice& L = c.volume.lattice;
+    const double cell = std::cbrt(L.spacing.prod());
+    // True crossing of stick v (NaN if none) and the vertex at t, physical.
+    auto stick = [&](const StickSurface& x, size_t v, Vec3& p) {
+      const auto l = x.lower_index(v);
+      const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
+      Vec3 b = a;
+      b[x.axis(v)] += 1;
+      p = L.to_physical(a + x.t[v] * (b - a));
+      return c.truth->crossing(L.to_physical(a), L.to_physical(b), x.t[v]);
+    };
+    const char* names[3] = {"frozen", "junction", "fresh"};
     for (const StickSurface* x : {&tiles, &s}) {
-      for (int k = 0; k < 3; ++k) sum[k] = 0, cnt[k] = 0;
+      double sum[3] = {0, 0, 0}, cnt[3] = {0, 0, 0};
       for (size_t v = 0; v < x->stick_count(); ++v) {
-        const auto l = x->lower_index(v);
-        Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
-        Vec3 b = a;
-        b[x->axis(v)] += 1;
-        const double tt = c.truth->crossing(L.to_physical(a), L.to_physical(b), x->t[v]);
+        Vec3 p;
+        const double tt = stick(*x, v, p);
         if (std::isnan(tt)) continue;
         const int k = seg.region[v] >= 0 ? 0 : seg.junction[v] ? 1 : 2;
         sum[k] += (tt - x->t[v]) * (tt - x->t[v]);
         ++cnt[k];
       }
-      std::fprintf(stderr, "%s: frozen %zu rms %.4f | junction %zu rms %.4f | fresh %zu rms %.4f\n", x == &s ? "final" : "tiles",
-                   cnt[0], std::sqrt(sum[0] / double(cnt[0])), cnt[1], std::sqrt(sum[1] / double(cnt[1])), cnt[2], std::sqrt(sum[2] / double(cnt[2])));
+      std::fprintf(stderr, "%s:", x == &s ? "final" : "tiles");
+      for (int k = 0; k < 3; ++k) std::fprintf(stderr, " %s %.0f rms %.4f |", names[k], cnt[k], std::sqrt(sum[k] / std::max(cnt[k], 1.0)));
+      std::fprintf(stderr, "\n");
     }
+    const auto edges = c.truth->sharp_edges(30);
+    const double bounds[] = {0.5, 1, 1.5, 2, 3, 1e300};
+    double bs[2][6] = {}, bc[2][6] = {};
+    std::vector<double> fs(seg.flats.size()), fd(seg.flats.size()), fc(seg.flats.size());
+    for (size_t v = 0; v < s.stick_count(); ++v) {
+      Vec3 p;
+      const double tt = stick(s, v, p);
+      if (std::isnan(tt)) continue;
+      const double e2 = (tt - s.t[v]) * (tt - s.t[v]);
+      double d = 1e300;
+      for (const auto& e : edges) {
+        const Vec3 u = e[1] - e[0];
+        const double w = std::clamp((p - e[0]).dot(u) / std::max(u.squaredNorm(), 1e-300), 0.0, 1.0);
+        d = std::min(d, (e[0] + w * u - p).norm() / cell);
+      }
+      int k = 0;
+      while (d > bounds[k]) ++k;
+      const int cls = seg.region[v] >= 0 ? 0 : 1;
+      bs[cls][k] += e2;
+      bc[cls][k] += 1;
+      if (cls == 0) {
+        const size_t f = size_t(seg.region[v]);
+        fs[f] += e2;
+        fd[f] += (c.truth->closest(p).point - p).squaredNorm() / (cell * cell);
+        fc[f] += 1;
+      }
+    }
+    for (int cls = 0; cls < 2; ++cls) {
+      std::fprintf(stderr, "%s, by distance to a true sharp edge (cells):", cls ? "fresh" : "frozen");
+      for (int k = 0; k < 6; ++k)
+        std::fprintf(stderr, " %s%.1f: %.0f rms %.3f |", k < 5 ? "<=" : ">", bounds[std::min(k, 4)], bc[cls][k],
+                     std::sqrt(bs[cls][k] / std::max(bc[cls][k], 1.0)));
+      std::fprintf(stderr, "\n");
+    }
+    for (size_t f = 0; f < fs.size(); ++f)
+      std::fprintf(stderr, "flat %zu: %.0f sticks, stick rms %.4f, distance rms %.4f, normal (%.3f %.3f %.3f)\n", f, fc[f],
+                   std::sqrt(fs[f] / std::max(fc[f], 1.0)), std::sqrt(fd[f] / std::max(fc[f], 1.0)), seg.flats[f].normal.x(),
+                   seg.flats[f].normal.y(), seg.flats[f].normal.z());
   }
   EvalOptions eo;
   eo.volume = &c.volume;
@@ -123,20 +171,23 @@ int main(int argc, char** argv) {
   CLI::App app{"voxpress flats benchmark"};
   std::string shape, model;
   int64_t res = 0;
-  int seeds = 0, iterations = 100;
+  int seeds = 0, first_seed = 1, iterations = 100;
   FlatOptions fo;
   bool split = false;
-  app.add_flag("--split", split, "Also print (stderr) the stick error by vertex class, missed faces, a model's planar faces");
+  app.add_flag("--split", split,
+               "Also print (stderr) where the stick error sits (vertex class, distance to the true sharp edges, each flat), missed faces, a model's planar faces");
   app.add_option("--shape", shape, "box | cylinder | cad-part | sphere | torus");
   app.add_option("--model", model, "a closed mesh to voxelize");
   app.add_option("--res", res);
   app.add_option("--seeds", seeds);
+  app.add_option("--first-seed", first_seed, "Seeds run from here (default 1)");
   app.add_option("--iterations", iterations);
   app.add_option("--min-flat-area", fo.min_area);
   app.add_option("--flat-bend", fo.max_bend);
   app.add_option("--flat-tolerance", fo.tolerance);
   app.add_option("--flat-width", fo.min_width);
   app.add_option("--flat-spread", fo.max_spread);
+  app.add_option("--flat-passes", fo.passes);
   CLI11_PARSE(app, argc, argv);
   struct Job {
     std::string shape, model;
@@ -160,7 +211,7 @@ int main(int argc, char** argv) {
   }
   bool header = true;
   for (const Job& j : jobs)
-    for (int seed = 1; seed <= j.seeds; ++seed) {
+    for (int seed = first_seed; seed < first_seed + j.seeds; ++seed) {
       Case c;
       const std::string rot = "random:" + std::to_string(seed);
       if (!j.shape.empty()) {

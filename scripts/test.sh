@@ -25,7 +25,7 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktra
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndGuaranteesHold:Sharpen.RotatedBoxesGetTheirEdgesBack:\
 Sharpen.SharpAngleOptionControlsTheLabels:Flats.RotatedBoxesHaveExactlySixFlatsWithinOneDegree:\
 Flats.CadPartPlanarFacesFoundNoneSpurious:Flats.RotatedCylinderHasTwoCapsAndACurvedWall:\
-Flats.RotatedBoxesAt64HaveNoSpuriousFlat:Flats.OrganicShapesHaveNoFlats:Flats.FlatsMakeTheBoxMoreAccurate:\
+Flats.RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats:Flats.OrganicShapesHaveNoFlats:Flats.FlatsMakeTheBoxMoreAccurate:\
 Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Metrics.MidpointRowOfThePaperIsReproduced:\
 Shapes.CadPartMeshIsAValidSolidMatchingItsClosedFormVolume"
 # smooth_tests, the longest, runs as two shards.

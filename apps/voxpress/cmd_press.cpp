@@ -194,6 +194,10 @@ void register_press(CLI::App& app, Global& g) {
       ->capture_default_str();
   f->add_option("--flat-bend", c->flats.max_bend, "Degrees: largest normal change across a flat")->capture_default_str();
   f->add_option("--flat-width", c->flats.min_width, "Cells: narrowest flat")->capture_default_str();
+  f->add_option("--flat-passes", c->flats.passes,
+                "Detection passes (each after the next estimate, pressed with the previous pass's flats frozen)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   f->add_flag("--color-regions", c->color_regions,
               "Colour the vertices by region (flats, curved grey, junctions orange, sharp curves red)");
   auto* sh = cmd->add_option_group("sharpen", "Sharp edge recovery (needs flats)");

@@ -752,8 +752,27 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   eo.tolerance = 0;
   eo.progress = nullptr;
   press(est, curves, eo);
-  const double t_est = seconds_since(t0);
+  double t_est = seconds_since(t0);
   FlatSegmentation seg = find_flats(s, curves, est.t, *fo);
+  // Beyond the paper: a second pass. The estimate of a face next to rounded
+  // edges is a pillow whose normals spread past the acceptance test (64^3
+  // boxes, thin plates). Pressed again with the first pass's flats frozen,
+  // their edges are sharp and the faces between them flat, so the second
+  // detection (from scratch, on the new estimate) finds the faces the
+  // first missed. Box 64, seeds 1-30: 162 -> 177 of 180 faces.
+  for (int pass = 1; pass < fo->passes && !seg.flats.empty(); ++pass) {
+    std::vector<uint8_t> frozen(s.stick_count());
+    for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = seg.region[v] >= 0;
+    const auto t1 = std::chrono::steady_clock::now();
+    est = s;
+    apply_flats(est, seg);
+    press(est, curves, eo, frozen, seg.barrier);
+    t_est += seconds_since(t1);
+    const FlatStats before = seg.stats;
+    seg = find_flats(s, curves, est.t, *fo);
+    seg.stats.seconds_detect += before.seconds_detect;
+    seg.stats.seconds_junctions += before.seconds_junctions;
+  }
   seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
   std::vector<uint8_t> frozen(s.stick_count());

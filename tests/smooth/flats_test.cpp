@@ -4,6 +4,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -82,26 +83,33 @@ TEST(Flats, RotatedBoxesHaveExactlySixFlatsWithinOneDegree) {
   }
 }
 
-TEST(Flats, RotatedBoxesAt64HaveNoSpuriousFlat) {
-  // At 64^3 the pressed estimate of the box is a pillow: on 3 of these 8
-  // rotations two to four faces spread like tangent strips and are
-  // missed (docs/BENCHMARKS.md). What is found is right, and most is found.
-  size_t found = 0;
-  for (int seed = 1; seed <= 8; ++seed) {
+TEST(Flats, RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats) {
+  // At 64^3 the first pressed estimate of a box is a pillow whose smaller
+  // faces spread like tangent strips; the second detection pass (estimate
+  // pressed with the first pass's flats frozen) finds them. Measured over
+  // seeds 1-30 (docs/BENCHMARKS.md): 27 rotations give exactly the six
+  // faces; seeds 15 and 22 split a face into pieces whose planes are a
+  // degree or more off (15: a face 2 degrees off a lattice axis, digitally
+  // terraces): 3 extra flats in all; seed 30 misses one face.
+  // One pass: 23 of 30, 162 faces.
+  size_t exact = 0, found = 0, spurious = 0;
+  for (int seed = 1; seed <= 30; ++seed) {
     SCOPED_TRACE("box 64 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::box, 64, seed);
     std::vector<int> used(6, 0);
+    size_t bad = 0;
     for (const Flat& f : r.seg.flats) {
       const int k = match(f, r.faces);
-      ASSERT_GE(k, 0) << "a flat matches no face of the box";
-      ++used[size_t(k)];
+      if (k < 0 || used[size_t(k)]++) ++bad;
     }
-    for (int u : used) EXPECT_LE(u, 1);
-    EXPECT_GE(r.seg.flats.size(), 2u);
-    found += r.seg.flats.size();
+    exact += r.seg.flats.size() == 6 && bad == 0;
+    found += size_t(std::count_if(used.begin(), used.end(), [](int u) { return u > 0; }));
+    spurious += bad;
     expect_guarantees(r.surface, r.seg, r.shape.volume);
   }
-  EXPECT_GE(found, 36u) << "of 48 faces (38 when written)";
+  EXPECT_GE(exact, 27u) << "rotations with exactly the six faces, of 30";
+  EXPECT_GE(found, 177u) << "faces found, of 180";
+  EXPECT_LE(spurious, 3u) << "flats matching no face or a face already taken";
 }
 
 TEST(Flats, RotatedCylinderHasTwoCapsAndACurvedWall) {

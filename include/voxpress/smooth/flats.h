@@ -68,6 +68,9 @@ struct FlatOptions {
   int rim_rings = 2;           ///< surface rings added around the core
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
   int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
+  /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
+  /// (their edges sharp, not rounded) and detects again from scratch.
+  int passes = 2;
   Progress* progress = nullptr;
 };
 
