@@ -760,13 +760,16 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   // their edges are sharp and the faces between them flat, so the second
   // detection (from scratch, on the new estimate) finds the faces the
   // first missed. Box 64, seeds 1-30: 162 -> 177 of 180 faces.
+  auto frozen_of = [](const FlatSegmentation& f) {
+    std::vector<uint8_t> frozen(f.region.size());
+    for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
+    return frozen;
+  };
   for (int pass = 1; pass < fo->passes && !seg.flats.empty(); ++pass) {
-    std::vector<uint8_t> frozen(s.stick_count());
-    for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = seg.region[v] >= 0;
     const auto t1 = std::chrono::steady_clock::now();
     est = s;
     apply_flats(est, seg);
-    press(est, curves, eo, frozen, seg.barrier);
+    press(est, curves, eo, frozen_of(seg), seg.barrier);
     t_est += seconds_since(t1);
     const FlatStats before = seg.stats;
     seg = find_flats(s, curves, est.t, *fo);
@@ -775,9 +778,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   }
   seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
-  std::vector<uint8_t> frozen(s.stick_count());
-  for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = seg.region[v] >= 0;
-  st.press = press(s, curves, po, frozen, seg.barrier);
+  st.press = press(s, curves, po, frozen_of(seg), seg.barrier);
   st.flats = seg.stats;
   if (out) *out = std::move(seg);
   return st;
