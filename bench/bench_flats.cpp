@@ -38,7 +38,7 @@ double stick_rms(const StickSurface& s, const Truth& truth, const BinaryVolume& 
   return evaluate(to_mesh(s), truth, eo).stick_rms_vox.value_or(NAN);
 }
 
-void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool split) {
+void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool split, const std::string& dump) {
   if (header)
     std::printf("| case | flats | true faces >= min | found | spurious | worst angle (deg) | estimate s | detect s | "
                 "junctions s | stick: midpoint | + tiles | + smoothing | r->t RMS | normal err (deg) | violations | "
@@ -86,7 +86,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
     }
     const auto edges = c.truth->sharp_edges(30);
     const double bounds[] = {0.5, 1, 1.5, 2, 3, 1e300};
-    double bs[2][6] = {}, bc[2][6] = {};
+    double bs[2][6] = {}, bc[2][6] = {}, bsg[2][6] = {};
     std::vector<double> fs(seg.flats.size()), fd(seg.flats.size()), fc(seg.flats.size());
     for (size_t v = 0; v < s.stick_count(); ++v) {
       Vec3 p;
@@ -104,6 +104,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
       const int cls = seg.region[v] >= 0 ? 0 : 1;
       bs[cls][k] += e2;
       bc[cls][k] += 1;
+      bsg[cls][k] += (s.lower_inside(v) ? 1 : -1) * (s.t[v] - tt);  // > 0: outside the truth
       if (cls == 0) {
         const size_t f = size_t(seg.region[v]);
         fs[f] += e2;
@@ -114,14 +115,34 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
     for (int cls = 0; cls < 2; ++cls) {
       std::fprintf(stderr, "%s, by distance to a true sharp edge (cells):", cls ? "fresh" : "frozen");
       for (int k = 0; k < 6; ++k)
-        std::fprintf(stderr, " %s%.1f: %.0f rms %.3f |", k < 5 ? "<=" : ">", bounds[std::min(k, 4)], bc[cls][k],
-                     std::sqrt(bs[cls][k] / std::max(bc[cls][k], 1.0)));
+        std::fprintf(stderr, " %s%.1f: %.0f rms %.3f mean %+.3f |", k < 5 ? "<=" : ">", bounds[std::min(k, 4)], bc[cls][k],
+                     std::sqrt(bs[cls][k] / std::max(bc[cls][k], 1.0)), bsg[cls][k] / std::max(bc[cls][k], 1.0));
       std::fprintf(stderr, "\n");
     }
     for (size_t f = 0; f < fs.size(); ++f)
       std::fprintf(stderr, "flat %zu: %.0f sticks, stick rms %.4f, distance rms %.4f, normal (%.3f %.3f %.3f)\n", f, fc[f],
                    std::sqrt(fs[f] / std::max(fc[f], 1.0)), std::sqrt(fd[f] / std::max(fc[f], 1.0)), seg.flats[f].normal.x(),
                    seg.flats[f].normal.y(), seg.flats[f].normal.z());
+  }
+  if (!dump.empty()) {
+    // The final surface coloured by stick error: white 0, red >= 0.5 cell;
+    // vertices whose stick the truth does not cross are blue.
+    Mesh m = to_mesh(s);
+    m.colors.resize(m.vertex_count());
+    const Lattice& L = c.volume.lattice;
+    for (size_t v = 0; v < s.stick_count(); ++v) {
+      const auto l = s.lower_index(v);
+      const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
+      Vec3 b = a;
+      b[s.axis(v)] += 1;
+      const double tt = c.truth->crossing(L.to_physical(a), L.to_physical(b), s.t[v]);
+      const double e = std::isnan(tt) ? -1 : std::min(std::abs(tt - s.t[v]) / 0.5, 1.0);
+      const auto g = uint8_t(255 * (1 - std::max(e, 0.0)));
+      m.colors[v] = e < 0 ? std::array<uint8_t, 4>{0, 0, 255, 255} : std::array<uint8_t, 4>{255, g, g, 255};
+    }
+    const std::string path = dump + c.name + ".ply";
+    write_mesh(path, m);
+    std::fprintf(stderr, "wrote %s\n", path.c_str());
   }
   EvalOptions eo;
   eo.volume = &c.volume;
@@ -174,8 +195,10 @@ int main(int argc, char** argv) {
   int seeds = 0, first_seed = 1, iterations = 100;
   FlatOptions fo;
   bool split = false;
+  std::string dump;
   app.add_flag("--split", split,
                "Also print (stderr) where the stick error sits (vertex class, distance to the true sharp edges, each flat), missed faces, a model's planar faces");
+  app.add_option("--dump", dump, "Write each final surface coloured by stick error (white 0, red >= 0.5 cell) to PREFIX<case>.ply");
   app.add_option("--shape", shape, "box | cylinder | cad-part | sphere | torus");
   app.add_option("--model", model, "a closed mesh to voxelize");
   app.add_option("--res", res);
@@ -248,7 +271,7 @@ int main(int argc, char** argv) {
         c.volume = std::move(v.volume);
         c.name = std::filesystem::path(j.model).stem().string() + " " + std::to_string(j.res) + " seed " + std::to_string(seed);
       }
-      run(c, fo, iterations, header, split);
+      run(c, fo, iterations, header, split, dump);
       header = false;
     }
   return 0;

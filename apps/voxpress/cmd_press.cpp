@@ -38,13 +38,14 @@ nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
           {"frozen", seg.frozen_count()},
           {"junctions", st.junctions},
           {"barriers", st.barriers},
+          {"crease_vertices", st.crease_vertices},
           {"votes", st.votes},
           {"voters", st.voters},
           {"cells", st.cells},
           {"cells_tried", st.tried},
           {"min_area_cells", o.min_area},
           {"junction_angle", o.junction_angle},
-          {"seconds", {{"estimate", st.seconds_estimate}, {"detect", st.seconds_detect}, {"junctions", st.seconds_junctions}}}};
+          {"seconds", {{"estimate", st.seconds_estimate}, {"detect", st.seconds_detect}, {"junctions", st.seconds_junctions}, {"creases", st.seconds_creases}}}};
 }
 
 nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
@@ -197,6 +198,10 @@ void register_press(CLI::App& app, Global& g) {
   f->add_option("--flat-passes", c->flats.passes,
                 "Detection passes (each after the next estimate, pressed with the previous pass's flats frozen)")
       ->check(CLI::Range(1, 8))
+      ->capture_default_str();
+  f->add_option("--crease-rounds", c->flats.crease_rounds,
+                "Rounds placing the curved vertices next to a sharp flat border by the curved side's quadric fit (0: off)")
+      ->check(CLI::Range(0, 8))
       ->capture_default_str();
   f->add_flag("--color-regions", c->color_regions,
               "Colour the vertices by region (flats, curved grey, junctions orange, sharp curves red)");

@@ -778,7 +778,28 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   }
   seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
-  st.press = press(s, curves, po, frozen_of(seg), seg.barrier);
+  // Beyond the paper: the vertices near sharp flat/curved borders placed
+  // by the curved side's fit (fit_creases), then the rest pressed again
+  // around them; the iterations are shared out so the cost is unchanged.
+  const bool creases = fo->crease_rounds > 0 && fo->crease_rings >= 0 && seg.stats.junctions > 0;
+  const int rest = creases ? po.iterations / 5 : 0;
+  PressOptions first = po;
+  first.iterations = po.iterations - fo->crease_rounds * rest;
+  st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
+  for (int round = 0; creases && round < fo->crease_rounds; ++round) {
+    std::vector<uint8_t> fixed;
+    const auto t2 = std::chrono::steady_clock::now();
+    seg.stats.crease_vertices = fit_creases(s, seg, *fo, &fixed);
+    seg.stats.seconds_creases += seconds_since(t2);
+    for (size_t v = 0; v < fixed.size(); ++v) fixed[v] |= seg.region[v] >= 0;
+    PressOptions again = po;
+    again.iterations = rest;
+    again.levels = 1;  // the fine stage goes on
+    const PressStats ps = press(s, curves, again, fixed, seg.barrier);
+    st.press.iterations += ps.iterations;
+    st.press.seconds += ps.seconds;
+    st.press.last_max_change = ps.last_max_change;
+  }
   st.flats = seg.stats;
   if (out) *out = std::move(seg);
   return st;

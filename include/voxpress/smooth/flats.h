@@ -43,7 +43,10 @@
 // curve become barriers: the smoothing cuts the curves there, so no virtual
 // neighbour is taken across the sharp feature (the open pieces keep a
 // clamped bilaplacian; the paper's Fig. 7 alignment was tried and dropped,
-// docs/ARCHITECTURE.md).
+// docs/ARCHITECTURE.md). Instead, beyond the paper, fit_creases places the
+// fresh vertices near a junction from a quadric fitted to the curved side
+// farther away, extrapolated up to the flat (press_with_flats alternates it
+// with short presses of the rest).
 #pragma once
 
 #include <array>
@@ -71,6 +74,14 @@ struct FlatOptions {
   /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
   /// (their edges sharp, not rounded) and detects again from scratch.
   int passes = 2;
+  /// Beyond the paper, fit_creases: fresh vertices up to `crease_rings`
+  /// rings from a junction are placed by a quadric fitted to the fresh
+  /// vertices of the next `crease_fit_rings` rings, when its RMS residual is
+  /// at most `crease_residual` cells; `crease_rounds` times (0: off).
+  int crease_rings = 3;
+  int crease_fit_rings = 5;
+  double crease_residual = 0.04;
+  int crease_rounds = 2;
   Progress* progress = nullptr;
 };
 
@@ -88,6 +99,8 @@ struct FlatStats {
   size_t votes = 0, voters = 0, cells = 0, tried = 0;
   size_t junctions = 0, barriers = 0;
   double seconds_estimate = 0, seconds_detect = 0, seconds_junctions = 0;
+  size_t crease_vertices = 0;  ///< vertices fit_creases placed (last round)
+  double seconds_creases = 0;  ///< all rounds of fit_creases
 };
 
 /// The segmentation of a stick surface into flats and the curved rest.
@@ -109,6 +122,15 @@ FlatSegmentation find_flats(const StickSurface& surface, const SliceCurves& curv
 /// Sets the frozen vertices of `surface` on their flats and every fresh
 /// vertex to t = 0.5: the "midpoint + tiles" surface of Table 2.
 void apply_flats(StickSurface& surface, const FlatSegmentation& flats);
+
+/// Beyond the paper: places the fresh vertices within `crease_rings` rings of
+/// a junction at the crossing of their stick with the piecewise surface
+/// there: the flat's plane and a quadric fitted to the fresh vertices just
+/// beyond (the curved side extrapolated), nearest the inside sample at a
+/// convex edge, farthest at a concave one. Returns how many moved; `zone`
+/// (optional) flags them.
+size_t fit_creases(StickSurface& surface, const FlatSegmentation& flats, const FlatOptions& options,
+                   std::vector<uint8_t>* zone = nullptr);
 
 struct FeaturePressStats {
   PressStats press;
