@@ -6,9 +6,11 @@
 #include "voxpress/smooth/flats.h"
 
 #include "core/timing.h"
+#include "quadric.h"
 #include "surface_graph.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
@@ -32,6 +34,7 @@ constexpr double kPi = std::numbers::pi;
 constexpr int kCube = 64;  // cube-map cells per face side: ~1.4 degrees
 constexpr int kNormalRings = 3;  // smoothing rounds of the estimated normals
 constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
+constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
 
 // ---------------------------------------------------------------- directions
 // Equal-angle cube map: face (axis a, sign), the two other coordinates
@@ -600,11 +603,14 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // fresh 2-ring plane leans more than junction_angle from the flat.
   const auto t1 = std::chrono::steady_clock::now();
   const double cos_j = std::cos(o.junction_angle * kPi / 180);
+  const double cell = std::cbrt(std::abs(M.determinant()));
+  tbb::enumerable_thread_specific<detail::RingScratch> scratch;
   auto detect_junctions = [&] {
   std::fill(seg.junction.begin(), seg.junction.end(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
       std::vector<uint32_t> ring;
       std::vector<Vec3> pts;
+      detail::RingScratch& rs = scratch.local();
       for (size_t v = r.begin(); v < r.end(); ++v) {
         if (seg.region[v] >= 0) continue;
         bool near_flat = false;
@@ -628,9 +634,36 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           if (q.eigenvalues(1) > 1e-9 * std::max(1.0, q.eigenvalues(2))) {  // not collinear
             const Vec3 ns = q.normal;
             sharp = false;
+            int32_t flat = -1;
             for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) {
               const int32_t f = seg.region[S.adj[k]];
-              if (f >= 0 && std::abs(ns.dot(seg.flats[size_t(f)].normal)) < cos_j) sharp = true;
+              if (f >= 0 && std::abs(ns.dot(seg.flats[size_t(f)].normal)) < cos_j) sharp = true, flat = f;
+            }
+            // Beyond the paper: a curved face tangent to the flat (a
+            // fillet) leans past the angle a couple of rings from the border
+            // once the flat's rim has reached onto it. The estimate is not
+            // rounded there (there is no crease to round), so a quadric
+            // fitted to the curved side 2-6 rings away is good, and its
+            // normal where v projects onto the flat is the flat's: smooth.
+            // At a true crease the fit is bad (rounded estimate) or its
+            // normal there leans: sharp stays.
+            if (sharp && flat >= 0 && o.tangent_residual > 0) {
+              detail::rings_around(uint32_t(v), kTangentRings[1], S.adj_off, S.adj,
+                                   [&](uint32_t w) { return seg.region[w] < 0; }, rs);
+              pts.clear();
+              Vec3 outward = Vec3::Zero();
+              for (const auto& [w, d] : rs.out)
+                if (d >= kTangentRings[0]) {
+                  pts.push_back(M * S.x[w]);
+                  outward += M * (S.outside(w) - S.inside(w));
+                }
+              detail::Quadric Q;
+              const Flat& F = seg.flats[size_t(flat)];
+              if (Q.fit(pts, outward) && Q.residual <= o.tangent_residual * cell) {
+                const Vec3 p = M * S.x[v];
+                const Vec3 foot = p - (F.normal.dot(p) - F.offset) * F.normal;
+                if (std::abs(Q.normal_at(foot).dot(F.normal)) >= cos_j) sharp = false;
+              }
             }
           }
         }

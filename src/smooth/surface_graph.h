@@ -55,6 +55,37 @@ inline void grow_rings(std::vector<uint32_t>& ring, int rings, const std::vector
   }
 }
 
+// Rings around v: out receives (vertex, ring) for v (ring 0) and every
+// vertex reached through vertices accepted by `ok` within `depth` rings.
+// `seen` (one stamp per vertex, all below `stamp` on entry) is scratch
+// reused between calls; `stamp` is advanced.
+struct RingScratch {
+  std::vector<uint32_t> seen;
+  uint32_t stamp = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+};
+template <class Ok>
+void rings_around(uint32_t v, uint32_t depth, const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj, Ok ok,
+                  RingScratch& r) {
+  if (r.seen.size() + 1 < off.size()) r.seen.assign(off.size() - 1, 0);
+  if (++r.stamp == 0) {  // wrapped: clear
+    std::fill(r.seen.begin(), r.seen.end(), 0);
+    r.stamp = 1;
+  }
+  r.out.assign(1, {v, 0});
+  r.seen[v] = r.stamp;
+  for (size_t q = 0; q < r.out.size(); ++q) {
+    const auto [a, d] = r.out[q];
+    if (d == depth) continue;
+    for (uint32_t k = off[a]; k < off[a + 1]; ++k) {
+      const uint32_t w = adj[k];
+      if (r.seen[w] == r.stamp || !ok(w)) continue;
+      r.seen[w] = r.stamp;
+      r.out.push_back({w, d + 1});
+    }
+  }
+}
+
 // Vertex adjacency of `n` vertices from triangles (CSR: the neighbours of v
 // are adj[off[v] .. off[v + 1]), sorted, each once).
 inline void vertex_adjacency(size_t n, const std::vector<Triangle>& triangles, std::vector<uint32_t>& off,

@@ -39,7 +39,9 @@
 // in V's 2-ring is compared with F's normal; above `junction_angle` V is a
 // junction (the edge crosses a sharp feature); so is a fresh vertex with
 // fewer than three fresh vertices in its 2-ring (squeezed between flats,
-// whatever the angle). Frozen vertices next to a junction along a slice
+// whatever the angle). Beyond the paper, a would-be junction whose curved
+// side fits a quadric whose normal at the flat is the flat's is a tangent
+// border (a fillet), not a junction. Frozen vertices next to a junction along a slice
 // curve become barriers: the smoothing cuts the curves there, so no virtual
 // neighbour is taken across the sharp feature (the open pieces keep a
 // clamped bilaplacian; the paper's Fig. 7 alignment was tried and dropped,
@@ -63,6 +65,11 @@ namespace voxpress {
 struct FlatOptions {
   double min_area = 100;       ///< smallest flat, in cell areas (index space)
   double junction_angle = 30;  ///< degrees (paper: 30)
+  /// Beyond the paper: a would-be junction whose curved side (2-6 rings
+  /// away) fits a quadric within this RMS (cells), with the quadric's normal
+  /// within junction_angle of the flat's where the vertex projects onto the
+  /// flat, is a tangent (smooth) border, e.g. a fillet (0: off).
+  double tangent_residual = 0.08;
   double cone = 3;             ///< degrees: a vertex votes for directions within this of its normal
   double tolerance = 0.3;      ///< cells: core vertices lie this close to the plane (estimate)
   double max_bend = 5;         ///< degrees: largest normal change across a flat's core (linear fit)

@@ -1,0 +1,85 @@
+// Private helper of the flats detector and the crease fit: a quadric height
+// field fitted to surface points by least squares, its normal, and where a
+// stick leaves the solid it bounds.
+#pragma once
+
+#include <Eigen/QR>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "surface_graph.h"
+
+namespace voxpress::detail {
+
+// z = h(a, b) = q0 a^2 + q1 a b + q2 b^2 + q3 a + q4 b + q5 over the frame
+// (m; u, w, n) of the points' PCA, n outward (the solid is below: z < h).
+struct Quadric {
+  Vec3 m, u, w, n;
+  Eigen::Matrix<double, 6, 1> q;
+  double residual = 0;  // RMS distance along n of the points to the fit
+
+  // False with fewer than 12 points or a rank-deficient design (a curve).
+  bool fit(const std::vector<Vec3>& pts, const Vec3& outward) {
+    if (pts.size() < 12) return false;
+    const Pca p = pca(pts);
+    m = p.mean;
+    n = p.normal.dot(outward) < 0 ? Vec3(-p.normal) : p.normal;
+    u = n.cross(std::abs(n.x()) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)).normalized();
+    w = n.cross(u);
+    Eigen::MatrixXd A(pts.size(), 6);
+    Eigen::VectorXd z(pts.size());
+    for (size_t k = 0; k < pts.size(); ++k) {
+      const Vec3 d = pts[k] - m;
+      const double a = u.dot(d), b = w.dot(d);
+      A.row(Eigen::Index(k)) << a * a, a * b, b * b, a, b, 1;
+      z(Eigen::Index(k)) = n.dot(d);
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    if (qr.rank() < 6) return false;
+    q = qr.solve(z);
+    residual = std::sqrt((A * q - z).squaredNorm() / double(pts.size()));
+    return true;
+  }
+
+  // Unit outward normal of the surface above (or below) point p.
+  Vec3 normal_at(const Vec3& p) const {
+    const Vec3 d = p - m;
+    const double a = u.dot(d), b = w.dot(d);
+    const double ha = 2 * q(0) * a + q(1) * b + q(3), hb = q(1) * a + 2 * q(2) * b + q(4);
+    return (n - ha * u - hb * w).normalized();
+  }
+
+  // Where the segment from `in` (t = 0) to `out` (t = 1) leaves the solid:
+  // g(t) = n . (p - m) - h(a, b) changes sign from - to +. The root nearest
+  // `near` in [lo, hi]; NaN if none.
+  double exit(const Vec3& in, const Vec3& out, double near, double lo, double hi) const {
+    const Vec3 e = out - in, d = in - m;
+    // a(t) = a0 + a1 t, b(t) = b0 + b1 t, z(t) = z0 + z1 t; g = A t^2 + B t + C.
+    const double a0 = u.dot(d), a1 = u.dot(e), b0 = w.dot(d), b1 = w.dot(e), z0 = n.dot(d), z1 = n.dot(e);
+    const double A = -(q(0) * a1 * a1 + q(1) * a1 * b1 + q(2) * b1 * b1);
+    const double B = z1 - (2 * q(0) * a0 * a1 + q(1) * (a0 * b1 + a1 * b0) + 2 * q(2) * b0 * b1 + q(3) * a1 + q(4) * b1);
+    const double C = z0 - (q(0) * a0 * a0 + q(1) * a0 * b0 + q(2) * b0 * b0 + q(3) * a0 + q(4) * b0 + q(5));
+    double roots[2];
+    int k = 0;
+    if (std::abs(A) < 1e-12 * (std::abs(B) + std::abs(C) + 1e-300)) {
+      if (B != 0) roots[k++] = -C / B;
+    } else {
+      const double disc = B * B - 4 * A * C;
+      if (disc >= 0) {
+        const double sq = std::sqrt(disc), r = -0.5 * (B + std::copysign(sq, B));
+        roots[k++] = r / A;
+        if (r != 0) roots[k++] = C / r;
+      }
+    }
+    double best = std::numeric_limits<double>::quiet_NaN();
+    for (int i = 0; i < k; ++i) {
+      const double t = roots[i];
+      if (!(t >= lo && t <= hi) || 2 * A * t + B <= 0) continue;  // inside to outside only
+      if (std::isnan(best) || std::abs(t - near) < std::abs(best - near)) best = t;
+    }
+    return best;
+  }
+};
+
+}  // namespace voxpress::detail
