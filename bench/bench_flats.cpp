@@ -53,22 +53,22 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
   StickSurface tiles = s;
   apply_flats(tiles, seg);
   const double with_tiles = stick_rms(tiles, *c.truth, c.volume);
+  // True crossing of stick v (NaN if none) and the vertex at t, physical.
+  auto stick = [&](const StickSurface& x, size_t v, Vec3& p) {
+    const Lattice& L = c.volume.lattice;
+    const auto l = x.lower_index(v);
+    const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
+    Vec3 b = a;
+    b[x.axis(v)] += 1;
+    p = L.to_physical(a + x.t[v] * (b - a));
+    return c.truth->crossing(L.to_physical(a), L.to_physical(b), x.t[v]);
+  };
   if (split) {
     // Where the stick error sits: by vertex class (frozen / junction /
     // fresh) for "+ tiles" and the final surface; the final error by
     // distance to the nearest true sharp edge (dihedral > 30 degrees); and
     // per flat, with the distance of its vertices to the truth.
-    const Lattice& L = c.volume.lattice;
-    const double cell = std::cbrt(L.spacing.prod());
-    // True crossing of stick v (NaN if none) and the vertex at t, physical.
-    auto stick = [&](const StickSurface& x, size_t v, Vec3& p) {
-      const auto l = x.lower_index(v);
-      const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
-      Vec3 b = a;
-      b[x.axis(v)] += 1;
-      p = L.to_physical(a + x.t[v] * (b - a));
-      return c.truth->crossing(L.to_physical(a), L.to_physical(b), x.t[v]);
-    };
+    const double cell = std::cbrt(c.volume.lattice.spacing.prod());
     const char* names[3] = {"frozen", "junction", "fresh"};
     for (const StickSurface* x : {&tiles, &s}) {
       double sum[3] = {0, 0, 0}, cnt[3] = {0, 0, 0};
@@ -129,13 +129,9 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
     // vertices whose stick the truth does not cross are blue.
     Mesh m = to_mesh(s);
     m.colors.resize(m.vertex_count());
-    const Lattice& L = c.volume.lattice;
     for (size_t v = 0; v < s.stick_count(); ++v) {
-      const auto l = s.lower_index(v);
-      const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
-      Vec3 b = a;
-      b[s.axis(v)] += 1;
-      const double tt = c.truth->crossing(L.to_physical(a), L.to_physical(b), s.t[v]);
+      Vec3 p;
+      const double tt = stick(s, v, p);
       const double e = std::isnan(tt) ? -1 : std::min(std::abs(tt - s.t[v]) / 0.5, 1.0);
       const auto g = uint8_t(255 * (1 - std::max(e, 0.0)));
       m.colors[v] = e < 0 ? std::array<uint8_t, 4>{0, 0, 255, 255} : std::array<uint8_t, 4>{255, g, g, 255};

@@ -38,7 +38,8 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
     out[v] = s.lower_inside(v) ? b : a;
   });
   // Ring distance of each fresh vertex from the junctions (over fresh
-  // vertices), and the flat of the junction it was reached from.
+  // vertices) up to R, beyond that kFar, and the flat of the junction it
+  // was reached from.
   constexpr uint32_t kFar = UINT32_MAX;
   std::vector<uint32_t> dist(n, kFar);
   std::vector<int32_t> flat(n, -1);
@@ -51,7 +52,7 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
     front.push_back(uint32_t(v));
   }
   const uint32_t R = uint32_t(o.crease_rings), F = uint32_t(o.crease_fit_rings);
-  for (uint32_t d = 0; d < R + F && !front.empty(); ++d) {
+  for (uint32_t d = 0; d < R && !front.empty(); ++d) {
     std::vector<uint32_t> next;
     for (uint32_t v : front)
       for (uint32_t k = off[v]; k < off[v + 1]; ++k) {

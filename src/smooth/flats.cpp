@@ -608,7 +608,6 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   auto detect_junctions = [&] {
   std::fill(seg.junction.begin(), seg.junction.end(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
-      std::vector<uint32_t> ring;
       std::vector<Vec3> pts;
       detail::RingScratch& rs = scratch.local();
       for (size_t v = r.begin(); v < r.end(); ++v) {
@@ -617,19 +616,12 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) near_flat |= seg.region[S.adj[k]] >= 0;
         if (!near_flat) continue;
         // Fresh vertices of the 2-ring (v included), in physical space.
-        ring.assign(1, uint32_t(v));
-        for (int depth = 0; depth < 2; ++depth) {
-          const size_t end = ring.size();
-          for (size_t q = 0; q < end; ++q)
-            for (uint32_t k = S.adj_off[ring[q]]; k < S.adj_off[ring[q] + 1]; ++k) {
-              const uint32_t w = S.adj[k];
-              if (seg.region[w] < 0 && std::find(ring.begin(), ring.end(), w) == ring.end()) ring.push_back(w);
-            }
-        }
+        const auto fresh = [&](uint32_t w) { return seg.region[w] < 0; };
+        detail::rings_around(uint32_t(v), 2, S.adj_off, S.adj, fresh, rs);
         bool sharp = true;  // too few fresh vertices for a plane: squeezed between flats
-        if (ring.size() >= 3) {
+        if (rs.out.size() >= 3) {
           pts.clear();
-          for (uint32_t w : ring) pts.push_back(M * S.x[w]);
+          for (const auto& [w, d] : rs.out) pts.push_back(M * S.x[w]);
           const Pca q = pca(pts);
           if (q.eigenvalues(1) > 1e-9 * std::max(1.0, q.eigenvalues(2))) {  // not collinear
             const Vec3 ns = q.normal;
@@ -648,8 +640,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             // At a true crease the fit is bad (rounded estimate) or its
             // normal there leans: sharp stays.
             if (sharp && flat >= 0 && o.tangent_residual > 0) {
-              detail::rings_around(uint32_t(v), kTangentRings[1], S.adj_off, S.adj,
-                                   [&](uint32_t w) { return seg.region[w] < 0; }, rs);
+              detail::rings_around(uint32_t(v), kTangentRings[1], S.adj_off, S.adj, fresh, rs);
               pts.clear();
               Vec3 outward = Vec3::Zero();
               for (const auto& [w, d] : rs.out)
