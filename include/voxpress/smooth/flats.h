@@ -76,6 +76,7 @@ struct FlatOptions {
   double max_spread = 1.4;     ///< degrees: largest median angle between a core normal and the plane's
   double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
   int rim_rings = 2;           ///< surface rings added around the core
+  double merge_angle = 3;      ///< degrees: adjacent flats this close are merged when one plane stabs both (0: off)
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
   int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
   /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
