@@ -68,19 +68,24 @@ void expect_guarantees(const StickSurface& s, const FlatSegmentation& seg, const
   }
 }
 
+// A box's run: exactly six flats, one per face, every guarantee kept.
+void expect_six_faces(const FlatRun& r) {
+  ASSERT_EQ(r.seg.flats.size(), 6u);
+  std::vector<int> used(6, 0);
+  for (const Flat& f : r.seg.flats) {
+    const int k = match(f, r.faces);
+    ASSERT_GE(k, 0) << "a flat matches no face of the box";
+    ++used[size_t(k)];
+  }
+  for (int u : used) EXPECT_EQ(u, 1) << "each face is found once";
+  expect_guarantees(r.surface, r.seg, r.shape.volume);
+}
+
 TEST(Flats, RotatedBoxesHaveExactlySixFlatsWithinOneDegree) {
   for (int seed = 1; seed <= 6; ++seed) {
     SCOPED_TRACE("box 128 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::box, 128, seed);
-    ASSERT_EQ(r.seg.flats.size(), 6u);
-    std::vector<int> used(6, 0);
-    for (const Flat& f : r.seg.flats) {
-      const int k = match(f, r.faces);
-      ASSERT_GE(k, 0) << "a flat matches no face of the box";
-      ++used[size_t(k)];
-    }
-    for (int u : used) EXPECT_EQ(u, 1) << "each face is found once";
-    expect_guarantees(r.surface, r.seg, r.shape.volume);
+    expect_six_faces(r);
   }
 }
 
@@ -121,15 +126,7 @@ TEST(Flats, FaceSplitInTwoFlatsIsMerged) {
   const FlatRun split = run(ShapeKind::box, 64, 22, no_merge);
   EXPECT_GT(split.seg.flats.size(), 6u) << "the case no longer splits a face: pick another";
   const FlatRun r = run(ShapeKind::box, 64, 22);
-  ASSERT_EQ(r.seg.flats.size(), 6u);
-  std::vector<int> used(6, 0);
-  for (const Flat& f : r.seg.flats) {
-    const int k = match(f, r.faces);
-    ASSERT_GE(k, 0) << "a flat matches no face of the box";
-    ++used[size_t(k)];
-  }
-  for (int u : used) EXPECT_EQ(u, 1) << "each face is found once";
-  expect_guarantees(r.surface, r.seg, r.shape.volume);
+  expect_six_faces(r);
   const auto truth = shape_truth(r.shape.kind, r.shape.linear, r.shape.translation);
   EvalOptions eo;
   eo.volume = &r.shape.volume;
