@@ -33,6 +33,9 @@
 //  5. Rim. The flat finally takes the stabbed sticks within `rim_rings`
 //     surface edges of its core, so it reaches its edges, where the estimate
 //     was rounded.
+//  6. Merge (beyond the paper). Two adjacent flats whose normals are within
+//     `merge_angle` become one when a single plane stabs both cores and 90 %
+//     of their members (one face the growth took in two halves).
 //
 // Junctions (Section 3): for an edge joining a frozen vertex of flat F and a
 // fresh vertex V, the normal of the least-squares plane of the fresh vertices
