@@ -56,10 +56,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
   // True crossing of stick v (NaN if none) and the vertex at t, physical.
   auto stick = [&](const StickSurface& x, size_t v, Vec3& p) {
     const Lattice& L = c.volume.lattice;
-    const auto l = x.lower_index(v);
-    const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
-    Vec3 b = a;
-    b[x.axis(v)] += 1;
+    const auto [a, b] = x.sample_points(v);
     p = L.to_physical(a + x.t[v] * (b - a));
     return c.truth->crossing(L.to_physical(a), L.to_physical(b), x.t[v]);
   };

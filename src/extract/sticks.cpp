@@ -140,6 +140,14 @@ Vec3 StickSurface::index_position(size_t s) const {
   return p;
 }
 
+std::array<Vec3, 2> StickSurface::sample_points(size_t s) const {
+  const auto i = lower_index(s);
+  const Vec3 a{double(i[0]), double(i[1]), double(i[2])};
+  Vec3 b = a;
+  b[axis(s)] += 1;
+  return {a, b};
+}
+
 uint64_t count_sticks(const BinaryVolume& volume) {
   const Padded pv(volume);
   const auto info = classify_rows(pv, nullptr);

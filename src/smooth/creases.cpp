@@ -30,12 +30,8 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
   std::vector<Vec3> x(n), in(n), out(n);
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
     x[v] = s.index_position(v);
-    const auto l = s.lower_index(v);
-    const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
-    Vec3 b = a;
-    b[s.axis(v)] += 1;
-    in[v] = s.lower_inside(v) ? a : b;
-    out[v] = s.lower_inside(v) ? b : a;
+    in[v] = s.inside_sample(v);
+    out[v] = s.outside_sample(v);
   });
   // Ring distance of each fresh vertex from the junctions (over fresh
   // vertices) up to R, beyond that kFar, and the flat of the junction it

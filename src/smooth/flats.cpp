@@ -107,18 +107,8 @@ struct Surface {
   std::vector<double> area;         // a third of the incident triangle areas (index space)
   std::vector<uint32_t> adj_off, adj;  // vertex adjacency (CSR)
   // Samples of stick v: inside and outside endpoints.
-  Vec3 inside(size_t v) const {
-    const auto l = s->lower_index(v);
-    Vec3 p = Vec3(double(l[0]), double(l[1]), double(l[2]));
-    if (!s->lower_inside(v)) p[s->axis(v)] += 1;
-    return p;
-  }
-  Vec3 outside(size_t v) const {
-    const auto l = s->lower_index(v);
-    Vec3 p = Vec3(double(l[0]), double(l[1]), double(l[2]));
-    if (s->lower_inside(v)) p[s->axis(v)] += 1;
-    return p;
-  }
+  Vec3 inside(size_t v) const { return s->inside_sample(v); }
+  Vec3 outside(size_t v) const { return s->outside_sample(v); }
 };
 
 // t (from the inside sample) where the plane crosses stick v, or NaN when it
@@ -435,8 +425,7 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
   const size_t n = s.stick_count();
   S.x.resize(n);
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
-    const auto l = s.lower_index(v);
-    Vec3 p = Vec3(double(l[0]), double(l[1]), double(l[2]));
+    Vec3 p = s.sample_points(v)[0];
     p[s.axis(v)] += t[v];
     S.x[v] = p;
   });

@@ -31,12 +31,17 @@ struct FlatRun {
   std::vector<PlanarFace> faces;  // physical
 };
 
-FlatRun run(ShapeKind kind, int64_t res, int seed, const FlatOptions& fo = {}) {
-  FlatRun r;
+// A shape at res^3 under the random rotation `seed`.
+GeneratedShape rotated(ShapeKind kind, int64_t res, int seed) {
   GenerateOptions go;
   go.res = res;
   go.rotation = parse_rotation("random:" + std::to_string(seed));
-  r.shape = generate_shape(kind, go);
+  return generate_shape(kind, go);
+}
+
+FlatRun run(ShapeKind kind, int64_t res, int seed, const FlatOptions& fo = {}) {
+  FlatRun r;
+  r.shape = rotated(kind, res, seed);
   for (const PlanarFace& f : shape_planar_faces(kind)) r.faces.push_back(transform_face(f, r.shape.linear, r.shape.translation));
   r.surface = extract_sticks(r.shape.volume);
   const SliceCurves curves = build_slice_curves(r.surface);
@@ -209,10 +214,7 @@ Stages stages(StickSurface& s, const BinaryVolume& v, const Truth& truth) {
 }
 
 TEST(Flats, FlatsMakeTheBoxMoreAccurate) {
-  GenerateOptions go;
-  go.res = 96;
-  go.rotation = parse_rotation("random:7");
-  const GeneratedShape g = generate_shape(ShapeKind::box, go);
+  const GeneratedShape g = rotated(ShapeKind::box, 96, 7);
   const auto truth = shape_truth(g.kind, g.linear, g.translation);
   StickSurface plain = extract_sticks(g.volume), flats = plain;
   press_with_flats(plain, build_slice_curves(plain), {}, nullptr);
@@ -233,10 +235,7 @@ TEST(Flats, FlatsMakeTheBoxMoreAccurate) {
 TEST(Flats, CreaseFitMakesTheCylinderRimMoreAccurate) {
   for (int seed = 1; seed <= 2; ++seed) {
     SCOPED_TRACE("cylinder 64 seed " + std::to_string(seed));
-    GenerateOptions go;
-    go.res = 64;
-    go.rotation = parse_rotation("random:" + std::to_string(seed));
-    const GeneratedShape g = generate_shape(ShapeKind::cylinder, go);
+    const GeneratedShape g = rotated(ShapeKind::cylinder, 64, seed);
     const auto truth = shape_truth(g.kind, g.linear, g.translation);
     StickSurface off = extract_sticks(g.volume), on = off;
     const SliceCurves curves = build_slice_curves(off);
@@ -258,10 +257,7 @@ TEST(Flats, CreaseFitMakesTheCylinderRimMoreAccurate) {
         continue;
       }
       ASSERT_LT(seg.region[v], 0) << "only fresh vertices are fitted";
-      const auto l = off.lower_index(v);
-      const Vec3 a = Vec3(double(l[0]), double(l[1]), double(l[2]));
-      Vec3 b = a;
-      b[off.axis(v)] += 1;
+      const auto [a, b] = off.sample_points(v);
       const double tt = truth->crossing(L.to_physical(a), L.to_physical(b), off.t[v]);
       if (std::isnan(tt)) continue;
       before += (tt - off.t[v]) * (tt - off.t[v]);
@@ -303,10 +299,7 @@ TEST(Flats, CreaseFitMakesTheCylinderRimMoreAccurate) {
 TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
   for (int seed = 1; seed <= 2; ++seed) {
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
-    GenerateOptions go;
-    go.res = 128;
-    go.rotation = parse_rotation("random:" + std::to_string(seed));
-    const GeneratedShape g = generate_shape(ShapeKind::cad_part, go);
+    const GeneratedShape g = rotated(ShapeKind::cad_part, 128, seed);
     Mesh tm = cad_part_mesh();
     for (Vec3& p : tm.positions) p = g.translation + g.linear * p;
     const auto truth = mesh_truth(std::move(tm), "cad part");
@@ -353,10 +346,7 @@ TEST(Flats, PropertyCorpusKeepsEveryGuarantee) {
 }
 
 TEST(Flats, SameResultForOneAndManyThreads) {
-  GenerateOptions go;
-  go.res = 72;
-  go.rotation = parse_rotation("random:3");
-  const GeneratedShape g = generate_shape(ShapeKind::cad_part, go);
+  const GeneratedShape g = rotated(ShapeKind::cad_part, 72, 3);
   StickSurface one = extract_sticks(g.volume), many = one;
   const SliceCurves curves = build_slice_curves(one);
   const FlatOptions fo;

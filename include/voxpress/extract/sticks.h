@@ -41,6 +41,11 @@ struct StickSurface {
   std::array<int64_t, 3> lower_index(size_t s) const;
   /// Index-space position of the stick's vertex: lower_index + t * e_axis.
   Vec3 index_position(size_t s) const;
+  /// Index-space positions of the stick's lower and upper samples.
+  std::array<Vec3, 2> sample_points(size_t s) const;
+  /// Index-space position of the stick's inside (outside) sample.
+  Vec3 inside_sample(size_t s) const { return sample_points(s)[lower_inside(s) ? 0 : 1]; }
+  Vec3 outside_sample(size_t s) const { return sample_points(s)[lower_inside(s) ? 1 : 0]; }
 };
 
 struct ExtractOptions {
