@@ -42,6 +42,14 @@ struct Quadric {
     return true;
   }
 
+  // The surface point above (or below) p along n.
+  Vec3 foot(const Vec3& p) const {
+    const Vec3 d = p - m;
+    const double a = u.dot(d), b = w.dot(d);
+    const double h = q(0) * a * a + q(1) * a * b + q(2) * b * b + q(3) * a + q(4) * b + q(5);
+    return p + (h - n.dot(d)) * n;
+  }
+
   // Unit outward normal of the surface above (or below) point p.
   Vec3 normal_at(const Vec3& p) const {
     const Vec3 d = p - m;

@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "core/predicates.h"
+#include "quadric.h"
 #include "surface_graph.h"
 
 namespace voxpress {
@@ -84,6 +85,7 @@ struct Sharpener {
   std::vector<uint32_t> leftovers;          // curved junction vertices that joined a flat
   std::vector<int8_t> plane_state;          // per original vertex: 0 unknown, 1 has plane, -1 none
   std::vector<Plane> plane;
+  detail::RingScratch rings;                // scratch of rings_around (tangent_plane, thin_strips)
   std::vector<uint32_t> fan_off, fan;       // triangles around each vertex (CSR)
   std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;  // refined triangles by their first vertex's bucket
   SharpenStats st;
@@ -96,10 +98,36 @@ struct Sharpener {
   Vec3 physical_normal(const Vec3& index_normal) const { return (Minv_t * index_normal).normalized(); }
   double angle_deg(const Vec3& na, const Vec3& nb) const { return degrees_between(physical_normal(na), physical_normal(nb)); }
 
-  // The plane of an original vertex's side (Section 5): its flat's plane, or
-  // for a curved vertex the least-squares plane of the fresh, non-junction
-  // vertices in its 2-ring (all fresh ones when fewer than 3), oriented
-  // outwards (along the sticks' inside -> outside directions).
+  // Beyond the paper: the 2-ring plane is a secant of a curved side, so on a
+  // cylinder of radius R its line with the flat lies ~ d^2 / 2R inside the
+  // crease (d ~ 2 cells from the crease to the ring's centre: 0.15 cell on
+  // the CAD part's hole at 128^3). Instead, the quadric (height field) of the
+  // fresh, non-junction vertices within `curved_fit_rings` rings of v over
+  // curved vertices, when it fits within `curved_fit_residual`, gives its
+  // tangent plane where v projects onto it; v is next to the crease, so that
+  // plane's line with the flat is within ~ (0.5 cell)^2 / 2R of it.
+  bool tangent_plane(uint32_t v, Plane& out) {
+    if (o.curved_fit_rings <= 0) return false;
+    detail::rings_around(v, uint32_t(o.curved_fit_rings), adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
+    std::vector<Vec3> pts;
+    Vec3 outward = Vec3::Zero();
+    for (const auto& [w, d] : rings.out)
+      if (!seg.junction[w]) {
+        pts.push_back(x[w]);
+        outward[s.axis(w)] += s.lower_inside(w) ? 1 : -1;
+      }
+    detail::Quadric Q;
+    if (!Q.fit(pts, outward) || Q.residual > o.curved_fit_residual) return false;
+    const Vec3 foot = Q.foot(x[v]);
+    out.n = Q.normal_at(foot);
+    out.c = out.n.dot(foot);
+    return true;
+  }
+
+  // The plane of an original vertex's side (Section 5), oriented outwards
+  // (along the sticks' inside -> outside directions): its flat's plane; for
+  // a curved vertex the paper's ring_plane, or beyond the paper its side's
+  // quadric tangent plane when the side fits one (tangent_plane).
   const Plane* plane_of(uint32_t v) {
     if (plane_state[v] != 0) return plane_state[v] > 0 ? &plane[v] : nullptr;
     plane_state[v] = -1;
@@ -110,6 +138,19 @@ struct Sharpener {
       plane_state[v] = 1;
       return &plane[v];
     }
+    if (tangent_plane(v, plane[v])) {
+      ++st.tangent_planes;
+    } else if (!ring_plane(v, plane[v])) {
+      return nullptr;
+    }
+    plane_state[v] = 1;
+    return &plane[v];
+  }
+
+  // Section 5's plane of a curved vertex: the least-squares plane of the
+  // fresh, non-junction vertices in its 2-ring (all fresh ones when fewer
+  // than 3); false when there are fewer than 3 or they are collinear.
+  bool ring_plane(uint32_t v, Plane& out) const {
     std::vector<uint32_t> ring{v};
     detail::grow_rings(ring, 2, adj_off, adj);
     std::vector<Vec3> pts;
@@ -123,12 +164,11 @@ struct Sharpener {
           towards[s.axis(q)] += s.lower_inside(q) ? 1 : -1;
         }
     }
-    if (pts.size() < 3) return nullptr;
+    if (pts.size() < 3) return false;
     const detail::Pca p = detail::pca(pts);
-    if (!(p.eigenvalues[1] > 1e-6)) return nullptr;  // collinear points
-    plane[v] = detail::oriented_plane(p, towards);
-    plane_state[v] = 1;
-    return &plane[v];
+    if (!(p.eigenvalues[1] > 1e-6)) return false;  // collinear points
+    out = detail::oriented_plane(p, towards);
+    return true;
   }
 
   // Section 5: an edge whose ends lie on two different faces (two flats, or
@@ -142,14 +182,59 @@ struct Sharpener {
     return seg.junction[a < 0 ? u : v] != 0;
   }
 
+  // Marks (2) the curved vertices of thin strips: a vertex at most
+  // `strip_rings` rings (over curved vertices) from a flat whose curved
+  // neighbours within `strip_rings` rings are all that close too. The
+  // flats' rims stop a few rings short of a crease the estimate rounded
+  // widely (the CAD part's 45-degree chamfer: strips 3-5 vertices wide, so
+  // neither side is a junction and the crease had no chamfer edge at all),
+  // and of a face crossed by a lattice row nearly in its plane. A real
+  // curved face is deeper than that a few rings in, so only its ragged
+  // border's pockets could qualify (docs/ARCHITECTURE.md: 2 rings measured
+  // best). Strip vertices join a flat's label but are not projected onto
+  // its plane: on the fandisk, whose flats include gently curved faces, the
+  // projection cost more accuracy than it gained.
+  void thin_strips(std::vector<uint8_t>& mark) {
+    const uint32_t W = uint32_t(std::max(0, o.strip_rings));
+    if (W == 0) return;
+    std::vector<uint32_t> depth(n, UINT32_MAX), front, next;
+    for (uint32_t v = 0; v < n; ++v) {
+      if (label[v] >= 0) continue;
+      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+        if (label[adj[k]] >= 0) {
+          depth[v] = 1;
+          front.push_back(v);
+          break;
+        }
+    }
+    for (uint32_t d = 2; d <= W + 1 && !front.empty(); ++d) {
+      next.clear();
+      for (uint32_t v : front)
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+          const uint32_t w = adj[k];
+          if (label[w] < 0 && depth[w] == UINT32_MAX) depth[w] = d, next.push_back(w);
+        }
+      front.swap(next);
+    }
+    for (uint32_t v = 0; v < n; ++v) {
+      if (label[v] >= 0 || mark[v] || depth[v] > W) continue;
+      detail::rings_around(v, W, adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
+      bool thin = true;
+      for (const auto& [w, d] : rings.out) thin = thin && depth[w] <= W;
+      if (thin) mark[v] = 2;
+    }
+  }
+
   // Beyond the paper: curved vertices that are not part of a curved face
   // join a flat. They are the vertices of small curved patches (fewer than
   // `min_curved`: slivers of chamfer the flats' planes did not stab near
-  // edges and corners, or holes inside a flat) and curved junction vertices
-  // with no curved surface around them (fewer than 3 fresh vertices in their
-  // 2-ring, so no plane of their own). Each joins the flat within 3 rings
-  // whose plane is nearest and is later projected onto it (a checked move),
-  // so creases lie between flats and real curved faces only.
+  // edges and corners, or holes inside a flat), of thin strips (thin_strips:
+  // a crease the flats stopped short of, or a seam inside a flat) and
+  // curved junction vertices with no curved surface around them (fewer than
+  // 3 fresh vertices in their 2-ring, so no plane of their own). Each joins
+  // the flat within 3 rings whose plane is nearest and, except in a strip,
+  // is later projected onto it (a checked move), so creases lie between
+  // flats and real curved faces only.
   void join_leftovers() {
     std::vector<uint8_t> small(n, 0);
     std::vector<uint32_t> comp, stack;
@@ -169,10 +254,12 @@ struct Sharpener {
       if (comp.size() < size_t(o.min_curved))
         for (uint32_t v : comp) small[v] = 1;
     }
+    thin_strips(small);
     std::vector<std::pair<uint32_t, int32_t>> joins;
     std::vector<uint32_t> ring;
     for (uint32_t v = 0; v < n; ++v) {
-      if (label[v] >= 0 || !(small[v] || (seg.junction[v] && !plane_of(v)))) continue;
+      Plane unused;
+      if (label[v] >= 0 || !(small[v] || (seg.junction[v] && !ring_plane(v, unused)))) continue;
       int32_t best = -1;
       double best_d = INFINITY;
       ring.assign(1, v);
@@ -190,8 +277,7 @@ struct Sharpener {
     }
     for (const auto& [v, f] : joins) {
       label[v] = f;
-      plane_state[v] = 0;
-      leftovers.push_back(v);
+      if (small[v] != 2) leftovers.push_back(v);  // a thin strip's vertices keep their place
     }
   }
 

@@ -52,6 +52,16 @@ struct SharpenOptions {
   double max_move = 2;        ///< cells: farthest a new vertex may move from where it was inserted
   int chain_iterations = 10;  ///< bilaplacian iterations along the feature chains (0: none)
   int min_curved = 25;        ///< vertices: smaller curved patches are chamfer leftovers and join a flat
+  /// Beyond the paper: curved vertices at most this many rings from a flat,
+  /// whose curved neighbours within as many rings are too, form a thin strip
+  /// and join a flat (0: off).
+  int strip_rings = 2;
+  /// Beyond the paper: a curved side's plane is the tangent plane of the
+  /// quadric fitted to its fresh vertices within this many rings, when the
+  /// fit's RMS residual is at most `curved_fit_residual` cells (0: the
+  /// paper's least-squares plane of the 2-ring).
+  int curved_fit_rings = 6;
+  double curved_fit_residual = 0.05;
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
 };
@@ -60,6 +70,7 @@ struct SharpenStats {
   size_t chamfer_edges = 0, chamfer_triangles = 0;
   size_t inserted = 0, corners = 0;   ///< new edge vertices, new corner vertices
   size_t fallbacks = 0;               ///< new vertices left where inserted (parallel planes, far solution, no plane)
+  size_t tangent_planes = 0;          ///< curved sides whose plane is their quadric's tangent plane
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
