@@ -90,12 +90,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
       const double tt = stick(s, v, p);
       if (std::isnan(tt)) continue;
       const double e2 = (tt - s.t[v]) * (tt - s.t[v]);
-      double d = 1e300;
-      for (const auto& e : edges) {
-        const Vec3 u = e[1] - e[0];
-        const double w = std::clamp((p - e[0]).dot(u) / std::max(u.squaredNorm(), 1e-300), 0.0, 1.0);
-        d = std::min(d, (e[0] + w * u - p).norm() / cell);
-      }
+      const double d = edges.empty() ? 1e300 : (closest_on_segments(p, edges) - p).norm() / cell;
       int k = 0;
       while (d > bounds[k]) ++k;
       const int cls = seg.region[v] >= 0 ? 0 : 1;

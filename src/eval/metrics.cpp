@@ -256,16 +256,8 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
       }
       std::vector<double> dp(pts.size()), dv(pts.size());
       tbb::parallel_for(size_t(0), pts.size(), [&](size_t i) {
-        double best = INFINITY;
-        Vec3 diff = Vec3::Zero();
-        for (const auto& sgm : to) {
-          const Vec3 e = sgm[1] - sgm[0];
-          const double l2 = e.squaredNorm();
-          const double u = l2 > 0 ? std::clamp((pts[i] - sgm[0]).dot(e) / l2, 0.0, 1.0) : 0.0;
-          const Vec3 d = sgm[0] + u * e - pts[i];
-          if (d.squaredNorm() < best) best = d.squaredNorm(), diff = d;
-        }
-        dp[i] = std::sqrt(best);
+        const Vec3 diff = closest_on_segments(pts[i], to) - pts[i];
+        dp[i] = diff.norm();
         dv[i] = vox(diff);
       });
       phys = dp.empty() ? 0 : *std::max_element(dp.begin(), dp.end());
@@ -293,6 +285,19 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
     o.progress->end();
   }
   return r;
+}
+
+Vec3 closest_on_segments(const Vec3& p, const std::vector<std::array<Vec3, 2>>& segments) {
+  double best = INFINITY;
+  Vec3 closest = p;
+  for (const auto& sgm : segments) {
+    const Vec3 e = sgm[1] - sgm[0];
+    const double l2 = e.squaredNorm();
+    const double u = l2 > 0 ? std::clamp((p - sgm[0]).dot(e) / l2, 0.0, 1.0) : 0.0;
+    const Vec3 q = sgm[0] + u * e;
+    if ((q - p).squaredNorm() < best) best = (q - p).squaredNorm(), closest = q;
+  }
+  return closest;
 }
 
 }  // namespace voxpress

@@ -1,5 +1,6 @@
-// Private helper of the flats detector and the crease fit: a quadric height
-// field fitted to surface points by least squares, its normal, and where a
+// Private helper of the flats' tangent test, the crease fit and sharpen's
+// curved-side planes: a quadric height field fitted to surface points by
+// least squares, its surface point and normal over a point, and where a
 // stick leaves the solid it bounds.
 #pragma once
 

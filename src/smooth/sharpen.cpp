@@ -24,6 +24,9 @@ constexpr double kPi = std::numbers::pi;
 constexpr int kBucket = 4;       // cells per side of the buckets of the local intersection test
 constexpr int kBisections = 8;   // steps when a move is cut back
 constexpr int kRounds = 8;       // passes over the new vertices' moves
+// join_leftovers' marks of curved vertices that join a flat.
+constexpr uint8_t kLeftover = 1;  // joins and is projected onto the flat's plane
+constexpr uint8_t kStrip = 2;     // joins the label only (thin_strips)
 
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
 
@@ -182,7 +185,7 @@ struct Sharpener {
     return seg.junction[a < 0 ? u : v] != 0;
   }
 
-  // Marks (2) the curved vertices of thin strips: a vertex at most
+  // Marks (kStrip) the curved vertices of thin strips: a vertex at most
   // `strip_rings` rings (over curved vertices) from a flat whose curved
   // neighbours within `strip_rings` rings are all that close too. The
   // flats' rims stop a few rings short of a crease the estimate rounded
@@ -221,7 +224,7 @@ struct Sharpener {
       detail::rings_around(v, W, adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
       bool thin = true;
       for (const auto& [w, d] : rings.out) thin = thin && depth[w] <= W;
-      if (thin) mark[v] = 2;
+      if (thin) mark[v] = kStrip;
     }
   }
 
@@ -252,7 +255,7 @@ struct Sharpener {
           if (label[adj[k]] < 0 && !seen[adj[k]]) seen[adj[k]] = 1, stack.push_back(adj[k]);
       }
       if (comp.size() < size_t(o.min_curved))
-        for (uint32_t v : comp) small[v] = 1;
+        for (uint32_t v : comp) small[v] = kLeftover;
     }
     thin_strips(small);
     std::vector<std::pair<uint32_t, int32_t>> joins;
@@ -277,7 +280,7 @@ struct Sharpener {
     }
     for (const auto& [v, f] : joins) {
       label[v] = f;
-      if (small[v] != 2) leftovers.push_back(v);  // a thin strip's vertices keep their place
+      if (small[v] != kStrip) leftovers.push_back(v);  // a thin strip's vertices keep their place
     }
   }
 

@@ -121,18 +121,14 @@ TEST(Sharpen, CadPartErrorDropsAndGuaranteesHold) {
 // Distances from points every quarter cell along the true sharp curves to
 // the nearest labelled edge of m, sorted.
 std::vector<double> crease_distances(const std::vector<std::array<Vec3, 2>>& truth, const Mesh& m) {
+  std::vector<std::array<Vec3, 2>> labelled;
+  for (const auto& e : m.edges) labelled.push_back({m.positions[e[0]], m.positions[e[1]]});
   std::vector<double> d;
   for (const auto& sg : truth) {
     const int k = std::max(1, int(std::ceil((sg[1] - sg[0]).norm() / 0.25)));
     for (int i = 0; i <= k; ++i) {
       const Vec3 p = sg[0] + (sg[1] - sg[0]) * (double(i) / k);
-      double best = INFINITY;
-      for (const auto& e : m.edges) {
-        const Vec3 a = m.positions[e[0]], ab = m.positions[e[1]] - a;
-        const double u = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-        best = std::min(best, (a + u * ab - p).squaredNorm());
-      }
-      d.push_back(std::sqrt(best));
+      d.push_back(labelled.empty() ? INFINITY : (closest_on_segments(p, labelled) - p).norm());
     }
   }
   std::sort(d.begin(), d.end());

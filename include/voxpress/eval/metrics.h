@@ -72,4 +72,8 @@ struct EvalReport {
 
 EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& options = {});
 
+/// The point of the segments nearest p (p itself when there are none); the
+/// sharp-edge metric's distance, also used by benchmarks and tests.
+Vec3 closest_on_segments(const Vec3& p, const std::vector<std::array<Vec3, 2>>& segments);
+
 }  // namespace voxpress
