@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
   int seeds = 0, first_seed = 1, iterations = 100;
   FlatOptions fo;
   bool split = false;
-  std::string dump;
+  std::string dump, rotate;
   app.add_flag("--split", split,
                "Also print (stderr) where the stick error sits (vertex class, distance to the true sharp edges, each flat), missed faces, a model's planar faces");
   app.add_option("--dump", dump, "Write each final surface coloured by stick error (white 0, red >= 0.5 cell) to PREFIX<case>.ply");
@@ -193,6 +193,7 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds);
   app.add_option("--first-seed", first_seed, "Seeds run from here (default 1)");
   app.add_option("--iterations", iterations);
+  app.add_option("--rotate", rotate, "One fixed rotation (AX,AY,AZ degrees, e.g. 0,0,0) instead of random:SEED; one case per job");
   app.add_option("--min-flat-area", fo.min_area);
   app.add_option("--flat-bend", fo.max_bend);
   app.add_option("--flat-tolerance", fo.tolerance);
@@ -222,9 +223,10 @@ int main(int argc, char** argv) {
   }
   bool header = true;
   for (const Job& j : jobs)
-    for (int seed = first_seed; seed < first_seed + j.seeds; ++seed) {
+    for (int seed = first_seed; seed < first_seed + (rotate.empty() ? j.seeds : 1); ++seed) {
       Case c;
-      const std::string rot = "random:" + std::to_string(seed);
+      const std::string rot = rotate.empty() ? "random:" + std::to_string(seed) : rotate;
+      const std::string tag = rotate.empty() ? " seed " + std::to_string(seed) : " rotate " + rotate;
       if (!j.shape.empty()) {
         GenerateOptions go;
         go.res = j.res;
@@ -234,7 +236,7 @@ int main(int argc, char** argv) {
         for (const PlanarFace& f : shape_planar_faces(g.kind)) c.faces.push_back(transform_face(f, g.linear, g.translation));
         if (g.kind == ShapeKind::sphere || g.kind == ShapeKind::torus) c.faces.push_back({Vec3(0, 0, 1), 1e300, 0});
         c.volume = std::move(g.volume);
-        c.name = j.shape + " " + std::to_string(j.res) + " seed " + std::to_string(seed);
+        c.name = j.shape + " " + std::to_string(j.res) + tag;
       } else {
         const Mesh m = read_mesh(j.model);
         VoxelizeOptions vo;
@@ -257,7 +259,7 @@ int main(int argc, char** argv) {
         }
         c.truth = mesh_truth(std::move(phys), j.model);
         c.volume = std::move(v.volume);
-        c.name = std::filesystem::path(j.model).stem().string() + " " + std::to_string(j.res) + " seed " + std::to_string(seed);
+        c.name = std::filesystem::path(j.model).stem().string() + " " + std::to_string(j.res) + tag;
       }
       run(c, fo, iterations, header, split, dump);
       header = false;

@@ -54,6 +54,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"inserted_vertices", st.inserted},
           {"corner_vertices", st.corners},
           {"fallbacks", st.fallbacks},
+          {"tangent_planes", st.tangent_planes},
           {"cut_back", st.cut_back},
           {"sharp_edges", st.sharp_edges},
           {"sharp_angle", o.sharp_angle},

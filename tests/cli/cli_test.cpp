@@ -441,6 +441,7 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   // Sharpened by default: face regions, labelled sharp edges, the features file, eval's sharp-edge distances.
   EXPECT_TRUE(st.contains("sharpen"));
   EXPECT_GT(st["sharpen"]["sharp_edges"].get<size_t>(), 0u);
+  EXPECT_EQ(st["sharpen"]["tangent_planes"].get<size_t>(), 0u);  // a box: no curved side
   ASSERT_TRUE(m.face_attribute("region") != nullptr);
   ASSERT_TRUE(m.vertex_attribute("feature") != nullptr);
   EXPECT_EQ(m.edges.size(), st["sharpen"]["sharp_edges"].get<size_t>());

@@ -98,10 +98,10 @@ TEST(Flats, RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats) {
   // At 64^3 the first pressed estimate of a box is a pillow whose smaller
   // faces spread like tangent strips; the second detection pass (estimate
   // pressed with the first pass's flats frozen) finds them. Measured over
-  // seeds 1-30 (docs/BENCHMARKS.md): 28 rotations give exactly the six
-  // faces; seed 15 fits a face 2 degrees off a lattice axis (it terraces)
-  // 1.2 degrees off and misses its opposite; seed 30 misses one face.
-  // One pass: 23 of 30, 162 faces; without the merge, 27 and 3 spurious.
+  // seeds 1-30 (docs/BENCHMARKS.md): 29 rotations give exactly the six
+  // faces; seed 15 has two faces 2 degrees off a lattice axis (they
+  // terrace) and misses both. One pass: 23 of 30, 162 faces. Before the
+  // refit's rounding fix and the growth's slack: 28, 177 and 1 spurious.
   size_t exact = 0, found = 0, spurious = 0;
   for (int seed = 1; seed <= 30; ++seed) {
     SCOPED_TRACE("box 64 seed " + std::to_string(seed));
@@ -117,28 +117,34 @@ TEST(Flats, RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats) {
     spurious += bad;
     expect_guarantees(r.surface, r.seg, r.shape.volume);
   }
-  EXPECT_GE(exact, 28u) << "rotations with exactly the six faces, of 30";
-  EXPECT_GE(found, 177u) << "faces found, of 180";
-  EXPECT_LE(spurious, 1u) << "flats matching no face or a face already taken";
+  EXPECT_GE(exact, 29u) << "rotations with exactly the six faces, of 30";
+  EXPECT_GE(found, 178u) << "faces found, of 180";
+  EXPECT_EQ(spurious, 0u) << "flats matching no face or a face already taken";
 }
 
 TEST(Flats, FaceSplitInTwoFlatsIsMerged) {
-  // Box 64 seed 22: the greedy growth takes two faces in halves whose planes
-  // are 1.1 degrees apart (stick error 0.2 on each); one plane stabs both
-  // halves' cores, so they merge into one flat within a degree of the face.
+  // CAD part 64 seed 50: without the merge the growth takes a face in two
+  // pieces, one of them 2.5 degrees off (a flat matching no face); one plane
+  // stabs both pieces' cores, so they merge. Measured: 6 -> 5 flats, stick
+  // error 0.238 -> 0.213 (bench_flats).
   FlatOptions no_merge;
   no_merge.merge_angle = 0;
-  const FlatRun split = run(ShapeKind::box, 64, 22, no_merge);
-  EXPECT_GT(split.seg.flats.size(), 6u) << "the case no longer splits a face: pick another";
-  const FlatRun r = run(ShapeKind::box, 64, 22);
-  expect_six_faces(r);
+  const FlatRun split = run(ShapeKind::cad_part, 64, 50, no_merge);
+  const FlatRun r = run(ShapeKind::cad_part, 64, 50);
+  auto unmatched = [](const FlatRun& f) {
+    return std::count_if(f.seg.flats.begin(), f.seg.flats.end(), [&](const Flat& fl) { return match(fl, f.faces) < 0; });
+  };
+  EXPECT_GT(unmatched(split), 0) << "the case no longer splits a face: pick another";
+  EXPECT_EQ(unmatched(r), 0);
+  EXPECT_LT(r.seg.flats.size(), split.seg.flats.size());
+  expect_guarantees(r.surface, r.seg, r.shape.volume);
   const auto truth = shape_truth(r.shape.kind, r.shape.linear, r.shape.translation);
   EvalOptions eo;
   eo.volume = &r.shape.volume;
   eo.samples = 50000;
   const double e_merged = *evaluate(to_mesh(r.surface), *truth, eo).stick_rms_vox;
   const double e_split = *evaluate(to_mesh(split.surface), *truth, eo).stick_rms_vox;
-  EXPECT_LT(e_merged, 0.8 * e_split) << "measured 0.152 -> 0.091";
+  EXPECT_LT(e_merged, 0.95 * e_split);
 }
 
 TEST(Flats, RotatedCylinderHasTwoCapsAndACurvedWall) {
@@ -307,6 +313,10 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
     auto stray = [&](double tangent_residual) {
       SurfaceOptions so;
       so.flat.tangent_residual = tangent_residual;
+      // The junction test alone: sharpen's thin strips (beyond the paper)
+      // can label a few stray edges of their own (seed 2: a 5-sample spot on
+      // the fillet, 8 voxels off; docs/ARCHITECTURE.md, Sharp edges).
+      so.sharp.strip_rings = 0;
       const Mesh m = smooth_surface(g.volume, so).mesh;
       EvalOptions eo;
       eo.volume = &g.volume;

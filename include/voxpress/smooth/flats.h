@@ -16,26 +16,31 @@
 //     offsets in bins of one cell. Votes are sorted into an accumulator.
 //  3. Grow, greedily from the best cell (Section 3: "repeat by removing the
 //     sticks of previous planes"): the cell's voters seed a cluster; the
-//     cluster grows over surface edges to every unassigned stick the plane
-//     stabs whose estimated vertex lies within `tolerance` of it; the plane is
+//     cluster grows over surface edges to every unassigned stick whose
+//     estimated vertex lies within `tolerance` of the plane and which the
+//     plane stabs, or misses by at most 5 % of the stick (a row of sticks
+//     the current plane just misses would otherwise cut the face in bands;
+//     the refit below must then stab them all); the plane is
 //     refitted (below) and the growth repeated until it stops. A cluster is a
 //     flat if its area is at least `min_area`, its width at least
 //     `min_width`, its normals' median angle to the plane's at most
 //     `max_spread` and their linear trend across it at most `max_bend`
 //     (these reject the strips where a plane is tangent to a curved surface).
 //     The sticks of a flat leave the accumulator; the next best cell follows.
-//  4. Refine. The least-squares plane of the cluster's estimated vertices is
-//     the target; the plane moves from the current one (which stabs the whole
-//     cluster) towards it as far as every cluster stick stays stabbed with
-//     the margin: the constraints are linear in (n, c), so this is an exact
-//     line search. The result is the best-fitting plane on that segment that
-//     is feasible (docs/ARCHITECTURE.md).
+//  4. Refine. The best-fitting plane (least squares of the cluster's
+//     estimated vertices) among those that stab every cluster stick with the
+//     margin: a minimum-norm point of a polytope in 3 unknowns (Seidel's LP
+//     method). When no plane stabs them all, the members the current plane
+//     misses leave the cluster and the plane moves from the current one
+//     towards the least-squares one as far as feasibility allows (an exact
+//     line search: the constraints are linear in (n, c))
+//     (docs/ARCHITECTURE.md).
 //  5. Rim. The flat finally takes the stabbed sticks within `rim_rings`
 //     surface edges of its core, so it reaches its edges, where the estimate
 //     was rounded.
 //  6. Merge (beyond the paper). Two adjacent flats whose normals are within
 //     `merge_angle` become one when a single plane stabs both cores and 90 %
-//     of their members (one face the growth took in two halves).
+//     of their members (one face the growth took in two pieces).
 //
 // Junctions (Section 3): for an edge joining a frozen vertex of flat F and a
 // fresh vertex V, the normal of the least-squares plane of the fresh vertices
