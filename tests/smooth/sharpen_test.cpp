@@ -169,7 +169,7 @@ TEST(Sharpen, ThinStripsAndTangentPlanesPlaceTheCreases) {
   strips.curved_fit_rings = 0;
   // Two-sided Hausdorff distance between the true and labelled creases,
   // summed over four rotations: strips trade a stray label on one seed for
-  // whole creases recovered on others (measured 21.0 -> 17.9; sharpdbg: seeds 1-4
+  // whole creases recovered on others (measured 21.0 -> 17.9; per seed, 1-4:
   // 7.3 / 5.9 / 5.9 / 1.9 -> 7.0 / 8.0 / 1.6 / 1.4).
   double h_paper = 0, h_strips = 0;
   for (int seed = 1; seed <= 4; ++seed) {
