@@ -112,6 +112,11 @@ struct Surface {
   std::vector<Vec3> x, nrm;         // estimated vertex positions and unit normals (index space)
   std::vector<double> area;         // a third of the incident triangle areas (index space)
   std::vector<uint32_t> adj_off, adj;  // vertex adjacency (CSR)
+  // The estimated positions of vertices vs, into pts.
+  void positions(const std::vector<uint32_t>& vs, std::vector<Vec3>& pts) const {
+    pts.resize(vs.size());
+    for (size_t q = 0; q < vs.size(); ++q) pts[q] = x[vs[q]];
+  }
   // Samples of stick v: inside and outside endpoints.
   Vec3 inside(size_t v) const { return s->inside_sample(v); }
   Vec3 outside(size_t v) const { return s->outside_sample(v); }
@@ -359,16 +364,14 @@ struct Detector {
     for (int round = 0; round < 12; ++round) {
       const size_t before = core.size();
       grow(core, 0, -1, [&](uint32_t w) { return near(w, P, o.tolerance, kGrowSlack); });
-      pts.resize(core.size());
-      for (size_t q = 0; q < core.size(); ++q) pts[q] = S.x[core[q]];
+      S.positions(core, pts);
       Plane next;
       if (!constrained_fit(S, core, pts, P.n, o.margin, next)) {
         // Fallback (no plane stabs them all): keep the members the current
         // plane stabs and move it towards the least-squares one as far as
         // feasibility allows.
         std::erase_if(core, [&](uint32_t v) { return std::isnan(crossing(S, v, P, o.margin)); });
-        pts.resize(core.size());
-        for (size_t q = 0; q < core.size(); ++q) pts[q] = S.x[core[q]];
+        S.positions(core, pts);
         const Plane F = fit_plane(pts, P.n);
         next = lerp(P, F, feasible_step(S, core, P, F, o.margin));
       }
@@ -646,8 +649,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             }
             if (in) core.push_back(v);
           }
-        pts.resize(core.size());
-        for (size_t q = 0; q < core.size(); ++q) pts[q] = S.x[core[q]];
+        S.positions(core, pts);
         if (core.size() < 3 || !constrained_fit(S, core, pts, planes[a].n, o.margin, P)) continue;
         for (size_t f : {a, b})
           for (uint32_t v : members[f])

@@ -118,39 +118,34 @@ TEST(Sharpen, CadPartErrorDropsAndGuaranteesHold) {
   }
 }
 
-// Distances from points every quarter cell along the true sharp curves to
-// the nearest labelled edge of m, sorted.
-std::vector<double> crease_distances(const std::vector<std::array<Vec3, 2>>& truth, const Mesh& m) {
-  std::vector<std::array<Vec3, 2>> labelled;
-  for (const auto& e : m.edges) labelled.push_back({m.positions[e[0]], m.positions[e[1]]});
+using Segments = std::vector<std::array<Vec3, 2>>;
+
+Segments labelled_edges(const Mesh& m) {
+  Segments e;
+  for (const auto& ed : m.edges) e.push_back({m.positions[ed[0]], m.positions[ed[1]]});
+  return e;
+}
+
+// Distances from points every quarter cell along `from` to the nearest
+// segment of `to` (infinite when `to` is empty; one infinite distance when
+// `from` is), sorted.
+std::vector<double> sampled_distances(const Segments& from, const Segments& to) {
   std::vector<double> d;
-  for (const auto& sg : truth) {
+  for (const auto& sg : from) {
     const int k = std::max(1, int(std::ceil((sg[1] - sg[0]).norm() / 0.25)));
     for (int i = 0; i <= k; ++i) {
       const Vec3 p = sg[0] + (sg[1] - sg[0]) * (double(i) / k);
-      d.push_back(labelled.empty() ? INFINITY : (closest_on_segments(p, labelled) - p).norm());
-    }
-  }
-  std::sort(d.begin(), d.end());
-  return d;
-}
-
-// Distances from points every quarter cell along the labelled edges of m to
-// the nearest true sharp curve, sorted.
-std::vector<double> labelled_distances(const std::vector<std::array<Vec3, 2>>& truth, const Mesh& m) {
-  std::vector<double> d;
-  for (const auto& e : m.edges) {
-    const Vec3 a = m.positions[e[0]], b = m.positions[e[1]];
-    const int k = std::max(1, int(std::ceil((b - a).norm() / 0.25)));
-    for (int i = 0; i <= k; ++i) {
-      const Vec3 p = a + (b - a) * (double(i) / k);
-      d.push_back((closest_on_segments(p, truth) - p).norm());
+      d.push_back(to.empty() ? INFINITY : (closest_on_segments(p, to) - p).norm());
     }
   }
   if (d.empty()) d.push_back(INFINITY);
   std::sort(d.begin(), d.end());
   return d;
 }
+
+// True sharp curves to the labelled edges of m, and back.
+std::vector<double> crease_distances(const Segments& truth, const Mesh& m) { return sampled_distances(truth, labelled_edges(m)); }
+std::vector<double> labelled_distances(const Segments& truth, const Mesh& m) { return sampled_distances(labelled_edges(m), truth); }
 
 double fraction_within(const std::vector<double>& sorted, double r) {
   return double(std::upper_bound(sorted.begin(), sorted.end(), r) - sorted.begin()) / double(sorted.size());
