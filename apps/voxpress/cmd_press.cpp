@@ -55,6 +55,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"corner_vertices", st.corners},
           {"fallbacks", st.fallbacks},
           {"tangent_planes", st.tangent_planes},
+          {"snapped", st.snapped},
           {"cut_back", st.cut_back},
           {"sharp_edges", st.sharp_edges},
           {"sharp_angle", o.sharp_angle},

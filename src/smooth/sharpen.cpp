@@ -11,6 +11,10 @@
 #include <numbers>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include "core/predicates.h"
 #include "quadric.h"
 #include "surface_graph.h"
@@ -23,7 +27,8 @@ constexpr uint32_t kNone = UINT32_MAX;
 constexpr double kPi = std::numbers::pi;
 constexpr int kBucket = 4;       // cells per side of the buckets of the local intersection test
 constexpr int kBisections = 8;   // steps when a move is cut back
-constexpr int kRounds = 8;       // passes over the new vertices' moves
+constexpr int kRounds = 8;       // passes over the new vertices' moves (then up to as many cutting back)
+constexpr double kAdvance = 1e-3;  // cells: a cut-back round where no vertex advances more is the last
 // join_leftovers' marks of curved vertices that join a flat.
 constexpr uint8_t kLeftover = 1;  // joins and is projected onto the flat's plane
 constexpr uint8_t kStrip = 2;     // joins the label only (thin_strips)
@@ -228,18 +233,9 @@ struct Sharpener {
     }
   }
 
-  // Beyond the paper: curved vertices that are not part of a curved face
-  // join a flat. They are the vertices of small curved patches (fewer than
-  // `min_curved`: slivers of chamfer the flats' planes did not stab near
-  // edges and corners, or holes inside a flat), of thin strips (thin_strips:
-  // a crease the flats stopped short of, or a seam inside a flat) and
-  // curved junction vertices with no curved surface around them (fewer than
-  // 3 fresh vertices in their 2-ring, so no plane of their own). Each joins
-  // the flat within 3 rings whose plane is nearest and, except in a strip,
-  // is later projected onto it (a checked move), so creases lie between
-  // flats and real curved faces only.
-  void join_leftovers() {
-    std::vector<uint8_t> small(n, 0);
+  // Calls f(patch) for each connected patch of curved vertices (label < 0).
+  template <class F>
+  void for_each_curved_patch(F&& f) const {
     std::vector<uint32_t> comp, stack;
     std::vector<uint8_t> seen(n, 0);
     for (uint32_t v0 = 0; v0 < n; ++v0) {
@@ -254,9 +250,141 @@ struct Sharpener {
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
           if (label[adj[k]] < 0 && !seen[adj[k]]) seen[adj[k]] = 1, stack.push_back(adj[k]);
       }
-      if (comp.size() < size_t(o.min_curved))
-        for (uint32_t v : comp) small[v] = kLeftover;
+      f(comp);
     }
+  }
+
+  // Beyond the paper: where the solid of the flats around v crosses v's
+  // stick. The flats are those with a member within `snap_rings` rings; their
+  // solid is the intersection of their half-spaces when their members lie
+  // inside each other's planes (a convex crease or corner: at least 3 to 1),
+  // the union when outside (concave), else undecided. Along the stick from
+  // its inside sample (s = 0) to its outside one (s = 1) the intersection is
+  // left at the first plane crossed outwards, the union at the last. False
+  // when undecided or when the crossing misses the stick by more than
+  // `snap_tolerance` cells along that plane's normal (or, with
+  // `need_crease`, when no two of the flats meet at `min_angle` or more);
+  // else s in [margin, 1 - margin] (clamped) and the flat whose plane it is on.
+  struct SnapScratch {
+    detail::RingScratch rings;
+    std::vector<int32_t> near_flats;
+  };
+  bool solid_crossing(uint32_t v, bool need_crease, SnapScratch& scratch, int32_t& flat, double& s_out) const {
+    const auto& ring = scratch.rings.out;
+    std::vector<int32_t>& near_flats = scratch.near_flats;
+    detail::rings_around(v, uint32_t(o.snap_rings), adj_off, adj, [](uint32_t) { return true; }, scratch.rings);
+    near_flats.clear();
+    for (const auto& [w, d] : ring)
+      if (seg.region[w] >= 0 && std::find(near_flats.begin(), near_flats.end(), seg.region[w]) == near_flats.end())
+        near_flats.push_back(seg.region[w]);
+    if (near_flats.empty()) return false;
+    if (need_crease) {
+      bool crease = false;
+      for (size_t i = 0; i < near_flats.size() && !crease; ++i)
+        for (size_t j = i + 1; j < near_flats.size() && !crease; ++j)
+          crease = angle_deg(seg.flats[size_t(near_flats[i])].index_normal,
+                             seg.flats[size_t(near_flats[j])].index_normal) >= o.min_angle;
+      if (!crease) return false;
+    }
+    auto height = [&](int32_t f, const Vec3& p) {
+      return seg.flats[size_t(f)].index_normal.dot(p) - seg.flats[size_t(f)].index_offset;
+    };
+    size_t inside = 0, outside = 0;
+    for (const auto& [w, d] : ring)
+      if (seg.region[w] >= 0)
+        for (int32_t f : near_flats)
+          if (f != seg.region[w]) (height(f, x[w]) < 0 ? inside : outside) += 1;
+    // One flat: its half-space.
+    const bool convex = near_flats.size() == 1 || inside >= 3 * outside;
+    const bool concave = near_flats.size() > 1 && outside >= 3 * inside;
+    if (convex == concave) return false;  // undecided
+    const Vec3 I = s.inside_sample(v), O = s.outside_sample(v);
+    double best = convex ? INFINITY : -INFINITY, rate = 0;
+    for (int32_t f : near_flats) {
+      const double h0 = height(f, I), h1 = height(f, O);
+      // Where the stick leaves the half-space (±inf: never / from the start).
+      const double at = h1 > h0 ? h0 / (h0 - h1) : h0 < 0 ? INFINITY : -INFINITY;
+      if (convex ? at < best : at > best) best = at, flat = f, rate = h1 - h0;
+    }
+    if (!std::isfinite(best)) return false;
+    const double miss = best < 0 ? -best * rate : best > 1 ? (best - 1) * rate : 0;
+    if (miss > o.snap_tolerance) return false;
+    s_out = std::clamp(best, o.margin, 1 - o.margin);
+    return true;
+  }
+
+  // Beyond the paper: the flats' rims stop a few rings short of a crease or
+  // a corner the estimate rounded, leaving a curved band or patch that the
+  // chamfer triangles would cut as a wide bevel. A curved patch whose
+  // sticks the flats' solid (solid_crossing) explains, all but a share
+  // `1 - snap_share`, is such a band, not a curved face (a fillet of radius
+  // r leaves its sticks ~0.4 r outside the solid); its explained vertices
+  // go, along their sticks, onto the solid and join the flat whose plane
+  // they reach. Flat members within 2 rings of another region whose stick
+  // the solid crosses on another flat's plane (the rim ran past the crease)
+  // move there too. Every vertex stays in its stick, so no sample changes
+  // side (Pressing's guarantee), and the creases then lie between vertices
+  // on the two planes.
+  void snap_to_flats() {
+    if (o.snap_rings <= 0) return;
+    // Candidates: curved vertices, and members up to 2 rings from a border.
+    std::vector<uint8_t> depth(n, UINT8_MAX);
+    std::vector<uint32_t> front, next;
+    for (uint32_t v = 0; v < n; ++v)
+      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+        if (seg.region[adj[k]] != seg.region[v]) {
+          depth[v] = 0;
+          front.push_back(v);
+          break;
+        }
+    for (uint8_t d = 1; d <= 2; ++d) {
+      next.clear();
+      for (uint32_t v : front)
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+          if (depth[adj[k]] == UINT8_MAX) depth[adj[k]] = d, next.push_back(adj[k]);
+      front.swap(next);
+    }
+    std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
+    std::vector<double> t(n, 0);
+    tbb::enumerable_thread_specific<SnapScratch> scratch;
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(n), 256), [&](const tbb::blocked_range<uint32_t>& r) {
+      SnapScratch& sc = scratch.local();
+      for (uint32_t v = r.begin(); v < r.end(); ++v) {
+        const bool member = seg.region[v] >= 0;
+        if (member && depth[v] > 2) continue;
+        if (!solid_crossing(v, member, sc, flat[v], t[v]) || flat[v] == seg.region[v]) flat[v] = -1;
+      }
+    });
+    for_each_curved_patch([&](const std::vector<uint32_t>& patch) {
+      size_t explained = 0;
+      for (uint32_t v : patch) explained += flat[v] >= 0;
+      if (double(explained) < o.snap_share * double(patch.size()))
+        for (uint32_t v : patch) flat[v] = -1;
+    });
+    for (uint32_t v = 0; v < n; ++v) {
+      if (flat[v] < 0) continue;
+      x[v] = s.inside_sample(v) + t[v] * (s.outside_sample(v) - s.inside_sample(v));
+      label[v] = flat[v];
+      ++st.snapped;
+    }
+  }
+
+  // Beyond the paper: curved vertices that are not part of a curved face
+  // join a flat. They are the vertices of small curved patches (fewer than
+  // `min_curved`: slivers of chamfer the flats' planes did not stab near
+  // edges and corners, or holes inside a flat), of thin strips (thin_strips:
+  // a crease the flats stopped short of, or a seam inside a flat) and
+  // curved junction vertices with no curved surface around them (fewer than
+  // 3 fresh vertices in their 2-ring, so no plane of their own). Each joins
+  // the flat within 3 rings whose plane is nearest and, except in a strip,
+  // is later projected onto it (a checked move), so creases lie between
+  // flats and real curved faces only.
+  void join_leftovers() {
+    std::vector<uint8_t> small(n, 0);
+    for_each_curved_patch([&](const std::vector<uint32_t>& patch) {
+      if (patch.size() < size_t(o.min_curved))
+        for (uint32_t v : patch) small[v] = kLeftover;
+    });
     thin_strips(small);
     std::vector<std::pair<uint32_t, int32_t>> joins;
     std::vector<uint32_t> ring;
@@ -581,6 +709,7 @@ struct Sharpener {
     plane.resize(n);
     label = seg.region;
     if (!seg.flats.empty()) {
+      snap_to_flats();
       join_leftovers();
       subdivide();
     } else {
@@ -592,8 +721,10 @@ struct Sharpener {
       spread_targets();
       // The moves, in order: leftovers onto their flat, edge vertices onto
       // their crease, then corners (Section 5). A move blocked by a
-      // neighbour that has not moved yet is retried in the next round; the
-      // last round cuts the remaining moves back to what is allowed.
+      // neighbour that has not moved yet is retried in the next round; from
+      // round kRounds on, the remaining moves are cut back to what is
+      // allowed, and retried (neighbours' cut-back moves may unblock them)
+      // while any vertex still advances, for up to kRounds more rounds.
       std::vector<std::pair<uint32_t, Vec3>> jobs;
       for (uint32_t v : leftovers) {
         const Flat& f = seg.flats[size_t(label[v])];
@@ -605,13 +736,19 @@ struct Sharpener {
       std::vector<uint8_t> done(jobs.size(), 0);
       // Neighbours that block each other (two vertices of one thin triangle)
       // get there together: a blocked vertex goes half way instead.
-      for (int round = 0; round < kRounds; ++round)
+      for (int round = 0; round < 2 * kRounds; ++round) {
+        const bool cut = round + 1 >= kRounds;
+        bool advanced = false;
         for (size_t j = 0; j < jobs.size(); ++j) {
           if (done[j]) continue;
           const uint32_t v = jobs[j].first;
-          done[j] = move(v, jobs[j].second, round + 1 == kRounds);
-          if (!done[j] && round + 1 < kRounds) move(v, (x[v] + jobs[j].second) / 2, false);
+          const Vec3 before = x[v];
+          done[j] = move(v, jobs[j].second, cut);
+          if (!done[j] && !cut) move(v, (x[v] + jobs[j].second) / 2, false);
+          advanced |= (x[v] - before).squaredNorm() > kAdvance * kAdvance;
         }
+        if (cut && !advanced) break;
+      }
       smooth_chains();
     }
     SharpenResult r;

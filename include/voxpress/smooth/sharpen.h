@@ -62,6 +62,16 @@ struct SharpenOptions {
   /// paper's least-squares plane of the 2-ring).
   int curved_fit_rings = 6;
   double curved_fit_residual = 0.05;
+  /// Beyond the paper: curved patches that the solid of the flats around
+  /// them explains (its crossing of each stick, searched over the flats
+  /// within `snap_rings` rings, misses by at most `snap_tolerance` cells for
+  /// a share `snap_share` of the patch's sticks) are bands the flats' rims
+  /// stopped short of: their vertices slide along their sticks onto the
+  /// flats (0: off). See snap_to_flats in sharpen.cpp.
+  int snap_rings = 8;
+  double snap_tolerance = 0.05;
+  double snap_share = 0.95;
+  double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
 };
@@ -70,6 +80,7 @@ struct SharpenStats {
   size_t chamfer_edges = 0, chamfer_triangles = 0;
   size_t inserted = 0, corners = 0;   ///< new edge vertices, new corner vertices
   size_t fallbacks = 0;               ///< new vertices left where inserted (parallel planes, far solution, no plane)
+  size_t snapped = 0;                 ///< original vertices slid along their sticks onto a flat (snap_to_flats)
   size_t tangent_planes = 0;          ///< curved sides whose plane is their quadric's tangent plane
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
