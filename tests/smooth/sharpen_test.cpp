@@ -313,6 +313,8 @@ TEST(Sharpen, SameResultForOneAndManyThreads) {
     tbb::task_arena arena(std::max(2, tbb::info::default_concurrency()));
     arena.execute([&] { b = run(g.volume); });
   }
+  EXPECT_GT(a.stats.snapped, 0u) << "the parallel part (snap_to_flats) runs";
+  EXPECT_EQ(a.stats.snapped, b.stats.snapped);
   EXPECT_EQ(a.after.positions, b.after.positions);
   EXPECT_EQ(a.after.triangles, b.after.triangles);
   EXPECT_EQ(a.after.edges, b.after.edges);

@@ -5,6 +5,12 @@
 // its vertices sample the lattice edges, never the crease itself. Sharpening
 // inserts the crease (Section 5, Fig. 8-10):
 //
+//  0. Beyond the paper: curved bands and corner patches the flats' rims
+//     stopped short of, recognised because the flats' own solid (their
+//     half-spaces intersected at a convex crease, united at a concave one)
+//     crosses their sticks, slide along their sticks onto the flats
+//     (`snap_rings`, `snap_tolerance`, `snap_share`); a curved face's
+//     sticks lie outside that solid and stay.
 //  1. Chamfer edges join vertices of two different regions (two flats, or a
 //     flat and a curved junction vertex); smooth flat/curved borders (no
 //     junction) and flats meeting at less than `min_angle` are left alone.
