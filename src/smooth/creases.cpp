@@ -34,10 +34,9 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
     out[v] = s.outside_sample(v);
   });
   // Ring distance of each fresh vertex from the junctions (over fresh
-  // vertices) up to R, beyond that kFar, and the flat of the junction it
+  // vertices) up to R, beyond that kUnreached, and the flat of the junction it
   // was reached from.
-  constexpr uint32_t kFar = UINT32_MAX;
-  std::vector<uint32_t> dist(n, kFar);
+  std::vector<uint32_t> dist(n, detail::kUnreached);
   std::vector<int32_t> flat(n, -1);
   std::vector<uint32_t> front;
   for (size_t v = 0; v < n; ++v) {
@@ -48,18 +47,11 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
     front.push_back(uint32_t(v));
   }
   const uint32_t R = uint32_t(o.crease_rings), F = uint32_t(o.crease_fit_rings);
-  for (uint32_t d = 0; d < R && !front.empty(); ++d) {
-    std::vector<uint32_t> next;
-    for (uint32_t v : front)
-      for (uint32_t k = off[v]; k < off[v + 1]; ++k) {
-        const uint32_t w = adj[k];
-        if (seg.region[w] >= 0 || dist[w] != kFar) continue;
-        dist[w] = d + 1;
-        flat[w] = flat[v];
-        next.push_back(w);
-      }
-    front.swap(next);
-  }
+  detail::spread_rings(std::move(front), 0, R, off, adj, dist, [&](uint32_t v, uint32_t w) {
+    if (seg.region[w] >= 0) return false;
+    flat[w] = flat[v];
+    return true;
+  });
   std::vector<uint32_t> members;
   for (size_t v = 0; v < n; ++v)
     if (dist[v] <= R) members.push_back(uint32_t(v));

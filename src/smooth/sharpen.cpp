@@ -105,6 +105,10 @@ struct Sharpener {
   }
 
   Vec3 physical_normal(const Vec3& index_normal) const { return (Minv_t * index_normal).normalized(); }
+  // Signed distance (index space, outward positive) from flat f's plane to p.
+  double height(int32_t f, const Vec3& p) const {
+    return seg.flats[size_t(f)].index_normal.dot(p) - seg.flats[size_t(f)].index_offset;
+  }
   double angle_deg(const Vec3& na, const Vec3& nb) const { return degrees_between(physical_normal(na), physical_normal(nb)); }
 
   // Beyond the paper: the 2-ring plane is a secant of a curved side, so on a
@@ -206,7 +210,7 @@ struct Sharpener {
   void thin_strips(std::vector<uint8_t>& mark) {
     const uint32_t W = uint32_t(std::max(0, o.strip_rings));
     if (W == 0) return;
-    std::vector<uint32_t> depth(n, UINT32_MAX), front, next;
+    std::vector<uint32_t> depth(n, detail::kUnreached), front;
     for (uint32_t v = 0; v < n; ++v) {
       if (label[v] >= 0) continue;
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
@@ -216,15 +220,8 @@ struct Sharpener {
           break;
         }
     }
-    for (uint32_t d = 2; d <= W + 1 && !front.empty(); ++d) {
-      next.clear();
-      for (uint32_t v : front)
-        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
-          const uint32_t w = adj[k];
-          if (label[w] < 0 && depth[w] == UINT32_MAX) depth[w] = d, next.push_back(w);
-        }
-      front.swap(next);
-    }
+    detail::spread_rings(std::move(front), 1, W + 1, adj_off, adj, depth,
+                         [&](uint32_t, uint32_t w) { return label[w] < 0; });
     for (uint32_t v = 0; v < n; ++v) {
       if (label[v] >= 0 || mark[v] || depth[v] > W) continue;
       detail::rings_around(v, W, adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
@@ -287,9 +284,6 @@ struct Sharpener {
                              seg.flats[size_t(near_flats[j])].index_normal) >= o.min_angle;
       if (!crease) return false;
     }
-    auto height = [&](int32_t f, const Vec3& p) {
-      return seg.flats[size_t(f)].index_normal.dot(p) - seg.flats[size_t(f)].index_offset;
-    };
     size_t inside = 0, outside = 0;
     for (const auto& [w, d] : ring)
       if (seg.region[w] >= 0)
@@ -329,8 +323,7 @@ struct Sharpener {
   void snap_to_flats() {
     if (o.snap_rings <= 0) return;
     // Candidates: curved vertices, and members up to 2 rings from a border.
-    std::vector<uint8_t> depth(n, UINT8_MAX);
-    std::vector<uint32_t> front, next;
+    std::vector<uint32_t> depth(n, detail::kUnreached), front;
     for (uint32_t v = 0; v < n; ++v)
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
         if (seg.region[adj[k]] != seg.region[v]) {
@@ -338,13 +331,7 @@ struct Sharpener {
           front.push_back(v);
           break;
         }
-    for (uint8_t d = 1; d <= 2; ++d) {
-      next.clear();
-      for (uint32_t v : front)
-        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-          if (depth[adj[k]] == UINT8_MAX) depth[adj[k]] = d, next.push_back(adj[k]);
-      front.swap(next);
-    }
+    detail::spread_rings(std::move(front), 0, 2, adj_off, adj, depth, [](uint32_t, uint32_t) { return true; });
     std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
     std::vector<double> t(n, 0);
     tbb::enumerable_thread_specific<SnapScratch> scratch;
@@ -400,8 +387,7 @@ struct Sharpener {
         for (uint32_t q : ring) {
           const int32_t f = label[q];
           if (f < 0) continue;
-          const Flat& fl = seg.flats[size_t(f)];
-          const double d = std::abs(fl.index_normal.dot(x[v]) - fl.index_offset);
+          const double d = std::abs(height(f, x[v]));
           if (d < best_d) best_d = d, best = f;
         }
       }
@@ -734,8 +720,7 @@ struct Sharpener {
       std::vector<std::pair<uint32_t, Vec3>> jobs;
       std::vector<uint8_t> retry;
       for (uint32_t v : leftovers) {
-        const Flat& f = seg.flats[size_t(label[v])];
-        jobs.push_back({v, x[v] - (f.index_normal.dot(x[v]) - f.index_offset) * f.index_normal});
+        jobs.push_back({v, x[v] - height(label[v], x[v]) * seg.flats[size_t(label[v])].index_normal});
         retry.push_back(1);
       }
       for (int corners = 0; corners < 2; ++corners)

@@ -86,6 +86,29 @@ void rings_around(uint32_t v, uint32_t depth, const std::vector<uint32_t>& off, 
   }
 }
 
+// Breadth-first rings from several sources at once: `front` holds the
+// vertices at ring distance `first` (already set in `dist`); each ring adds
+// the neighbours w of its vertices v that are unreached (dist[w] ==
+// kUnreached) and that enter(v, w) admits (it may record what w inherits
+// from v), with dist[w] = ring, up to ring `last`. Visits in a fixed order.
+constexpr uint32_t kUnreached = UINT32_MAX;
+template <class Enter>
+void spread_rings(std::vector<uint32_t> front, uint32_t first, uint32_t last, const std::vector<uint32_t>& off,
+                  const std::vector<uint32_t>& adj, std::vector<uint32_t>& dist, Enter enter) {
+  std::vector<uint32_t> next;
+  for (uint32_t d = first; d < last && !front.empty(); ++d) {
+    next.clear();
+    for (uint32_t v : front)
+      for (uint32_t k = off[v]; k < off[v + 1]; ++k) {
+        const uint32_t w = adj[k];
+        if (dist[w] != kUnreached || !enter(v, w)) continue;
+        dist[w] = d + 1;
+        next.push_back(w);
+      }
+    front.swap(next);
+  }
+}
+
 // Vertex adjacency of `n` vertices from triangles (CSR: the neighbours of v
 // are adj[off[v] .. off[v + 1]), sorted, each once).
 inline void vertex_adjacency(size_t n, const std::vector<Triangle>& triangles, std::vector<uint32_t>& off,

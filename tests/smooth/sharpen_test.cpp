@@ -65,6 +65,13 @@ Vec3 face_normal(const Mesh& m, size_t f) {
   return (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]).normalized();
 }
 
+// Original vertices left curved (region -1) in the sharpened mesh.
+size_t curved_vertices(const Sharpened& r) {
+  const auto* region = r.after.vertex_attribute("region");
+  return size_t(std::count_if(region->values.begin(), region->values.begin() + ptrdiff_t(r.surface.stick_count()),
+                              [](double v) { return v < 0; }));
+}
+
 TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
   for (int seed = 1; seed <= 3; ++seed) {
     SCOPED_TRACE("box 128 seed " + std::to_string(seed));
@@ -83,11 +90,8 @@ TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
     // 1-30 meet it, docs/BENCHMARKS.md).
     EXPECT_LT(*after.sharp_edge_hausdorff_vox, 0.15);
     // Every original vertex ends on a flat: no bevel is left curved.
-    const auto* region = r.after.vertex_attribute("region");
-    ASSERT_NE(region, nullptr);
-    EXPECT_EQ(std::count_if(region->values.begin(), region->values.begin() + ptrdiff_t(r.surface.stick_count()),
-                            [](double v) { return v < 0; }),
-              0);
+    ASSERT_NE(r.after.vertex_attribute("region"), nullptr);
+    EXPECT_EQ(curved_vertices(r), 0u);
     // Dihedral angles across the labelled edges: the box's 90 degrees.
     std::map<std::pair<uint32_t, uint32_t>, std::vector<size_t>> faces;
     for (size_t f = 0; f < r.after.face_count(); ++f)
@@ -190,12 +194,6 @@ TEST(Sharpen, ThinStripsAndTangentPlanesPlaceTheCreases) {
     EXPECT_GT(c.stats.tangent_planes, 100u);
   }
   EXPECT_LT(h_strips, 0.9 * h_paper);
-}
-
-size_t curved_vertices(const Sharpened& r) {
-  const auto* region = r.after.vertex_attribute("region");
-  return size_t(std::count_if(region->values.begin(), region->values.begin() + ptrdiff_t(r.surface.stick_count()),
-                              [](double v) { return v < 0; }));
 }
 
 TEST(Sharpen, SnappingTakesBevelsNotCurvedFaces) {
