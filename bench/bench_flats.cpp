@@ -200,6 +200,7 @@ int main(int argc, char** argv) {
   app.add_option("--flat-width", fo.min_width);
   app.add_option("--flat-spread", fo.max_spread);
   app.add_option("--flat-passes", fo.passes);
+  app.add_flag("!--no-stab-refit", fo.stab_refit, "Without the flats' stabbing refit (near-axis faces)");
   CLI11_PARSE(app, argc, argv);
   struct Job {
     std::string shape, model;

@@ -85,6 +85,11 @@ struct FlatOptions {
   double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
   int rim_rings = 2;           ///< surface rings added around the core
   double merge_angle = 3;      ///< degrees: adjacent flats this close are merged when one plane stabs both (0: off)
+  /// Beyond the paper: refit each core's plane by the count of sticks it
+  /// stabs around it, not by the estimate (faces near a lattice axis, whose
+  /// estimate is a pillow); also rescues cores the spread and bend tests
+  /// refused when that plane stabs 90 % of their neighbourhood.
+  bool stab_refit = true;
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
   int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
   /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
