@@ -400,9 +400,10 @@ struct Detector {
       // A face's pillowed estimate can fail the spread and bend tests
       // (restab): rescued when, refitted by stabbing, its plane stabs at
       // least kRestabTrigger of its neighbourhood. A plane tangent to a
-      // curved surface stabs a strip and misses its sides (cylinders at
-      // 128-256: 0.58-0.79 of the candidates; torus 0.74-0.85; pillowed box
-      // faces and the CAD part's chamfer 0.93-1.0).
+      // curved surface stabs a strip and misses its sides (measured with a
+      // 10-degree window, which holds fewer of a strip's sides than the
+      // 15 used: cylinders at 128-256 0.58-0.79 of the candidates, torus
+      // 0.74-0.85; pillowed box faces and the CAD part's chamfer 0.93-1.0).
       double area = 0;
       for (uint32_t v : core) area += S.area[v];
       std::vector<uint32_t> again = core;
