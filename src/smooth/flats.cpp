@@ -396,33 +396,28 @@ struct Detector {
       P = next;
       if (core.size() == before && moved < 1e-7) break;
     }
-    if (!accept(core, P)) {
-      // A face's pillowed estimate can fail the spread and bend tests
-      // (restab): rescued when, refitted by stabbing, its plane stabs at
-      // least kRestabTrigger of its neighbourhood. A plane tangent to a
-      // curved surface stabs a strip and misses its sides (measured with a
-      // 10-degree window, which holds fewer of a strip's sides than the
-      // 15 used: cylinders at 128-256 0.58-0.79 of the candidates, torus
-      // 0.74-0.85; pillowed box faces and the CAD part's chamfer 0.93-1.0).
-      double area = 0;
-      for (uint32_t v : core) area += S.area[v];
+    // The stabbing refit (restab). An accepted core keeps its result only
+    // when it explains its neighbourhood: next to a gently curved face
+    // (fandisk) the search tilts the plane into it. A refused core whose
+    // pillowed estimate failed the spread or bend test is rescued the same
+    // way: a plane tangent to a curved surface stabs a strip and misses its
+    // sides (measured with a 10-degree window, which holds fewer of a
+    // strip's sides than the 15 used: cylinders at 128-256 0.58-0.79 of the
+    // candidates, torus 0.74-0.85; pillowed box faces and the CAD part's
+    // chamfer 0.93-1.0).
+    bool ok = accept(core, P);
+    if (o.stab_refit && (ok || area_of(core) >= o.min_area)) {
       std::vector<uint32_t> again = core;
       Plane Q = P;
-      if (!o.stab_refit || area < o.min_area || restab(again, Q, true) < kRestabTrigger) {
-        rejected = std::move(core);
-        return {};
-      }
-      core.swap(again);
-      P = Q;
-    } else {
-      // Kept only when the refit explains its neighbourhood: next to a
-      // gently curved face (fandisk) the search tilts the plane into it.
-      std::vector<uint32_t> again = core;
-      Plane Q = P;
-      if (o.stab_refit && restab(again, Q, false) >= kRestabTrigger) {
+      if (restab(again, Q, !ok) >= kRestabTrigger) {
         core.swap(again);
         P = Q;
+        ok = true;
       }
+    }
+    if (!ok) {
+      rejected = std::move(core);
+      return {};
     }
     ++stamp;  // restab marked its candidates: only the core may stay marked
     for (uint32_t v : core) mark[v] = stamp;
@@ -475,22 +470,16 @@ struct Detector {
       size_t now = 0;
       const size_t best = most_stabbing(cand, P, Q, now);
       if (double(best) < kRestabGain * double(now)) return share;
-      // The connected set Q stabs, from the core's stabbed vertices.
-      const uint32_t cand_mark = stamp, taken = ++stamp;
+      // The connected set of candidates (still marked core_mark: grow
+      // marked them so) that Q stabs, from the core's stabbed vertices.
+      const uint32_t taken = ++stamp;
       next.clear();
       for (uint32_t v : core)
         if (!std::isnan(crossing(S, v, Q, o.margin))) {
           mark[v] = taken;
           next.push_back(v);
         }
-      for (size_t q = 0; q < next.size(); ++q)
-        for (uint32_t k = S.adj_off[next[q]]; k < S.adj_off[next[q] + 1]; ++k) {
-          const uint32_t w = S.adj[k];
-          if ((mark[w] == cand_mark || mark[w] == core_mark) && !std::isnan(crossing(S, w, Q, o.margin))) {
-            mark[w] = taken;
-            next.push_back(w);
-          }
-        }
+      grow(next, 0, -1, [&](uint32_t w) { return mark[w] == core_mark && !std::isnan(crossing(S, w, Q, o.margin)); });
       if (next.size() <= core.size()) return share;
       S.positions(next, pts);
       if (!constrained_fit(S, next, pts, Q.n, o.margin, P)) P = Q;
@@ -564,10 +553,14 @@ struct Detector {
 
   // Section 3's minimum size, plus width and bend (beyond the paper: without
   // them a plane tangent to a cylinder holds a long strip of its sticks).
-  bool accept(const std::vector<uint32_t>& core, const Plane& P) const {
+  double area_of(const std::vector<uint32_t>& vs) const {
     double area = 0;
-    for (uint32_t v : core) area += S.area[v];
-    if (area < o.min_area) return false;
+    for (uint32_t v : vs) area += S.area[v];
+    return area;
+  }
+
+  bool accept(const std::vector<uint32_t>& core, const Plane& P) const {
+    if (area_of(core) < o.min_area) return false;
     // Spread of the normals about the plane's, robust to the rounded rims:
     // the median angle. A strip where a plane is tangent to a curved surface
     // is *defined* by the cone, so its normals fill it (median ~ cone / 2 at
