@@ -294,16 +294,27 @@ struct Sharpener {
     const bool concave = near_flats.size() > 1 && outside >= 3 * inside;
     if (convex == concave) return false;  // undecided
     const Vec3 I = s.inside_sample(v), O = s.outside_sample(v);
-    double best = convex ? INFINITY : -INFINITY, rate = 0;
+    double best = convex ? INFINITY : -INFINITY, miss = 0;
     for (int32_t f : near_flats) {
       const double h0 = height(f, I), h1 = height(f, O);
-      // Where the stick leaves the half-space (±inf: never / from the start).
-      const double at = h1 > h0 ? h0 / (h0 - h1) : h0 < 0 ? INFINITY : -INFINITY;
-      if (convex ? at < best : at > best) best = at, flat = f, rate = h1 - h0;
+      // Where the stick leaves the half-space, and by how much (along the
+      // normal) that misses the stick. A stick that never crosses the plane
+      // outwards leaves at its inside end when it starts outside (h0 >= 0;
+      // at = -h0, so that of several the farthest outside leaves first), else
+      // at its outside end: a sample a hair on the wrong side of a flat's
+      // plane (a face through a sample) must not hide the crossing.
+      double at, miss_f;
+      if (h1 > h0) {
+        at = h0 / (h0 - h1);
+        miss_f = at < 0 ? h0 : at > 1 ? -h1 : 0;
+      } else if (h0 >= 0) {
+        at = -h0, miss_f = h0;
+      } else {
+        at = 1 - h1, miss_f = -h1;
+      }
+      if (convex ? at < best : at > best) best = at, flat = f, miss = miss_f;
     }
-    if (!std::isfinite(best)) return false;
-    const double miss = best < 0 ? -best * rate : best > 1 ? (best - 1) * rate : 0;
-    if (miss > o.snap_tolerance) return false;
+    if (!std::isfinite(best) || miss > o.snap_tolerance) return false;
     s_out = std::clamp(best, o.margin, 1 - o.margin);
     return true;
   }
