@@ -26,7 +26,7 @@ export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndGuaranteesHold:Sharpen.ThinStr
 Sharpen.SharpAngleOptionControlsTheLabels:Flats.RotatedBoxesHaveExactlySixFlatsWithinOneDegree:\
 Flats.CadPartPlanarFacesFoundNoneSpurious:Flats.RotatedCylinderHasTwoCapsAndACurvedWall:\
 Flats.RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats:Flats.OrganicShapesHaveNoFlats:Flats.FlatsMakeTheBoxMoreAccurate:\
-Flats.FilletTangentToAFlatIsNotAJunction:\
+Flats.FilletTangentToAFlatIsNotAJunction:Flats.CreaseRefitPinsFacesAlongALatticeAxis:\
 Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Metrics.MidpointRowOfThePaperIsReproduced:\
 Shapes.CadPartMeshIsAValidSolidMatchingItsClosedFormVolume"
 # smooth_tests, the longest, runs as two shards.

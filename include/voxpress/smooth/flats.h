@@ -90,6 +90,10 @@ struct FlatOptions {
   /// estimate is a pillow); also rescues cores the spread and bend tests
   /// refused when that plane stabs 90 % of their neighbourhood.
   bool stab_refit = true;
+  /// Beyond the paper: refit the planes so that they also keep the samples
+  /// of their sharp creases on the right side (faces nearly containing a
+  /// lattice axis, whose own sticks leave their tilt loose).
+  bool crease_refit = true;
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
   int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
   /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
