@@ -41,6 +41,13 @@
 //  6. Merge (beyond the paper). Two adjacent flats whose normals are within
 //     `merge_angle` become one when a single plane stabs both cores and 90 %
 //     of their members (one face the growth took in two pieces).
+//  7. Crease refit (beyond the paper, final pass). Each plane must also keep
+//     the samples along its sharp creases on their side (inside samples of
+//     a convex crease inside every plane there, an outside sample outside
+//     the one plane it is not clearly inside of; concave the reverse); a
+//     plane that does not is refitted with them as one-sided constraints.
+//     This pins the tilt of faces nearly containing a lattice axis, which
+//     their own sticks leave loose.
 //
 // Junctions (Section 3): for an edge joining a frozen vertex of flat F and a
 // fresh vertex V, the normal of the least-squares plane of the fresh vertices
