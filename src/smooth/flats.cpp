@@ -231,15 +231,6 @@ class MinNorm {
   std::vector<uint32_t> order_;
 };
 
-// Section 3's plane refinement, our choice of "best": least squares inside
-// the feasible set. With n = n_F + a u + b v (n_F the least-squares normal
-// of the points, u, v orthonormal to it) and the plane n . (x - m) = c'
-// through the points' mean m, the squared residuals are a quadratic in
-// z = (a, b, c') minimised at z = 0, and "the plane stabs stick s with the
-// margin" is two linear inequalities in z. With H = L L^T the residuals'
-// Hessian and w = L^T z this is the minimum-norm point of a polytope.
-// Returns false when the cluster is infeasible or the solver fails
-// numerically (the caller keeps a feasible plane).
 // A sample a plane must leave strictly on one side (crease_refit).
 struct SideConstraint {
   Vec3 p;
@@ -251,6 +242,16 @@ struct SideConstraint {
 };
 constexpr double kSideMargin = 1e-6;  // cells: how strictly a SideConstraint's sample is on its side
 
+// Section 3's plane refinement, our choice of "best": least squares inside
+// the feasible set. With n = n_F + a u + b v (n_F the least-squares normal
+// of the points, u, v orthonormal to it) and the plane n . (x - m) = c'
+// through the points' mean m, the squared residuals are a quadratic in
+// z = (a, b, c') minimised at z = 0, and "the plane stabs stick s with the
+// margin" is two linear inequalities in z. With H = L L^T the residuals'
+// Hessian and w = L^T z this is the minimum-norm point of a polytope.
+// `sides` adds one-sided constraints (crease_refit), linear in z as well.
+// Returns false when the cluster is infeasible or the solver fails
+// numerically (the caller keeps a feasible plane).
 bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, const std::vector<Vec3>& pts,
                      const Vec3& towards, double margin, Plane& out, const std::vector<SideConstraint>& sides = {}) {
   Vec3 m = Vec3::Zero();
