@@ -314,7 +314,7 @@ struct Sharpener {
       }
       if (convex ? at < best : at > best) best = at, flat = f, miss = miss_f;
     }
-    if (!std::isfinite(best) || miss > o.snap_tolerance) return false;
+    if (miss > o.snap_tolerance) return false;  // every plane gave a finite `at`
     s_out = std::clamp(best, o.margin, 1 - o.margin);
     return true;
   }
