@@ -684,32 +684,24 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
     detail::rings_around(v, kCreaseRings, S.adj_off, S.adj, [](uint32_t) { return true; }, sc.rs);
     std::vector<int32_t>& near = sc.near;
     near.clear();
-    for (const auto& [w, d] : sc.rs.out)
-      if (const int32_t r = seg.region[w]; r >= 0 && std::find(near.begin(), near.end(), r) == near.end())
-        near.push_back(r);
+    detail::add_flats(sc.rs.out, seg.region, near);
     if (near.size() < 2) return;
-    // Convex or concave: the members here lie inside the other flats' planes, or outside.
-    size_t in = 0, out = 0;
-    for (const auto& [w, d] : sc.rs.out)
-      if (const int32_t r = seg.region[w]; r >= 0) {
-        const Vec3 x = S.inside(w) + seg.t[w] * (S.outside(w) - S.inside(w));
-        for (int32_t g : near)
-          if (g != r) (height(g, x) < 0 ? in : out) += 1;
-      }
-    const bool convex = in >= 3 * out, concave = out >= 3 * in;
-    if (convex == concave) return;
+    // Convex or concave: the members here (on their planes) lie inside the other flats' planes, or outside.
+    const int kind = detail::crease_kind(
+        sc.rs.out, seg.region, near, [&](uint32_t w) -> Vec3 { return S.inside(w) + seg.t[w] * (S.outside(w) - S.inside(w)); },
+        height);
+    if (kind == 0) return;
+    const bool convex = kind > 0;
     // Every plane but v's own keeps the sample that must be on its side of all of them.
     const Vec3 all = convex ? S.inside(v) : S.outside(v);
     for (int32_t g : near)
-      if (g != own) add(g, all, concave);
+      if (g != own) add(g, all, !convex);
     if (own >= 0) return;  // a member's own plane separates its samples: the disjunction holds
     // The disjunction must know every plane that may bound the solid here
     // (a corner's third face, whose rim may stop a few rings short).
     detail::rings_around(v, kCreaseReach, S.adj_off, S.adj, [](uint32_t) { return true; }, sc.wide);
     sc.wider = near;
-    for (const auto& [w, d] : sc.wide.out)
-      if (const int32_t r = seg.region[w]; r >= 0 && std::find(sc.wider.begin(), sc.wider.end(), r) == sc.wider.end())
-        sc.wider.push_back(r);
+    detail::add_flats(sc.wide.out, seg.region, sc.wider);
     // The sample that must be on the other side of one plane: the plane it is not clearly inside (outside) of.
     const Vec3 one = convex ? S.outside(v) : S.inside(v);
     const double sg = convex ? 1 : -1;
@@ -726,16 +718,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
   for (int round = 0; round < kCreaseRounds; ++round) {
     // Ring distance to a border between regions (flats, curved): beyond
     // kCreaseRings, no other flat is near and a member is inner.
-    std::vector<uint32_t> depth(n, detail::kUnreached), front;
-    for (uint32_t v = 0; v < n; ++v)
-      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k)
-        if (seg.region[S.adj[k]] != seg.region[v]) {
-          depth[v] = 0;
-          front.push_back(v);
-          break;
-        }
-    detail::spread_rings(std::move(front), 0, kCreaseRings, S.adj_off, S.adj, depth,
-                         [](uint32_t, uint32_t) { return true; });
+    const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, kCreaseRings, S.adj_off, S.adj);
     tbb::enumerable_thread_specific<Scratch> scratch([F] {
       Scratch sc;
       sc.broken.assign(F, 0);
@@ -1144,8 +1127,10 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     return convex ? tg < tf : tg > tf;
   };
   std::vector<uint8_t> refitted;
+  bool stale = true;  // regions changed since the junctions were last detected
   for (int round = 0; round < kExtendRounds && !seg.flats.empty(); ++round) {
-    detect_junctions();
+    if (stale) detect_junctions();
+    stale = false;
     // Beyond the paper: the planes also keep their creases' samples on the right side.
     const bool refit = o.crease_refit && crease_refit(S, o, seg, planes, refitted);
     if (refit) {
@@ -1178,8 +1163,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       seg.region[v] = f;
       seg.t[v] = crossing(S, v, planes[size_t(f)], o.margin);
     }
+    stale = !moves.empty();
   }
-  detect_junctions();
+  if (stale) detect_junctions();
   // Sizes, once the extension has settled the members. Index-space area ->
   // physical: |det M| |M^-T n| for a plane of unit index normal n.
   for (Flat& f : seg.flats) f.sticks = 0, f.area_cells = 0;

@@ -272,9 +272,7 @@ struct Sharpener {
     std::vector<int32_t>& near_flats = scratch.near_flats;
     detail::rings_around(v, uint32_t(o.snap_rings), adj_off, adj, [](uint32_t) { return true; }, scratch.rings);
     near_flats.clear();
-    for (const auto& [w, d] : ring)
-      if (seg.region[w] >= 0 && std::find(near_flats.begin(), near_flats.end(), seg.region[w]) == near_flats.end())
-        near_flats.push_back(seg.region[w]);
+    detail::add_flats(ring, seg.region, near_flats);
     if (near_flats.empty()) return false;
     if (need_crease) {
       bool crease = false;
@@ -284,15 +282,12 @@ struct Sharpener {
                              seg.flats[size_t(near_flats[j])].index_normal) >= o.min_angle;
       if (!crease) return false;
     }
-    size_t inside = 0, outside = 0;
-    for (const auto& [w, d] : ring)
-      if (seg.region[w] >= 0)
-        for (int32_t f : near_flats)
-          if (f != seg.region[w]) (height(f, x[w]) < 0 ? inside : outside) += 1;
     // One flat: its half-space.
-    const bool convex = near_flats.size() == 1 || inside >= 3 * outside;
-    const bool concave = near_flats.size() > 1 && outside >= 3 * inside;
-    if (convex == concave) return false;  // undecided
+    const int kind = detail::crease_kind(
+        ring, seg.region, near_flats, [&](uint32_t w) { return x[w]; },
+        [&](int32_t f, const Vec3& p) { return height(f, p); });
+    if (kind == 0) return false;  // undecided
+    const bool convex = kind > 0;
     const Vec3 I = s.inside_sample(v), O = s.outside_sample(v);
     double best = convex ? INFINITY : -INFINITY, miss = 0;
     for (int32_t f : near_flats) {
@@ -334,15 +329,7 @@ struct Sharpener {
   void snap_to_flats() {
     if (o.snap_rings <= 0) return;
     // Candidates: curved vertices, and members up to 2 rings from a border.
-    std::vector<uint32_t> depth(n, detail::kUnreached), front;
-    for (uint32_t v = 0; v < n; ++v)
-      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-        if (seg.region[adj[k]] != seg.region[v]) {
-          depth[v] = 0;
-          front.push_back(v);
-          break;
-        }
-    detail::spread_rings(std::move(front), 0, 2, adj_off, adj, depth, [](uint32_t, uint32_t) { return true; });
+    const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, 2, adj_off, adj);
     std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
     std::vector<double> t(n, 0);
     tbb::enumerable_thread_specific<SnapScratch> scratch;

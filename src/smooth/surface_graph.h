@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "voxpress/core/progress.h"
@@ -107,6 +108,54 @@ void spread_rings(std::vector<uint32_t> front, uint32_t first, uint32_t last, co
       }
     front.swap(next);
   }
+}
+
+// Ring distance of every vertex from a border between regions (a vertex
+// with a neighbour of another region is at 0), up to `rings`; kUnreached
+// beyond.
+inline std::vector<uint32_t> region_border_rings(const std::vector<int32_t>& region, uint32_t rings,
+                                                 const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj) {
+  const size_t n = region.size();
+  std::vector<uint32_t> depth(n, kUnreached), front;
+  for (uint32_t v = 0; v < n; ++v)
+    for (uint32_t k = off[v]; k < off[v + 1]; ++k)
+      if (region[adj[k]] != region[v]) {
+        depth[v] = 0;
+        front.push_back(v);
+        break;
+      }
+  spread_rings(std::move(front), 0, rings, off, adj, depth, [](uint32_t, uint32_t) { return true; });
+  return depth;
+}
+
+// Appends to `out` the regions >= 0 (flats) of the vertices of `ring`
+// (rings_around's output) that it does not hold yet, in ring order.
+inline void add_flats(const std::vector<std::pair<uint32_t, uint32_t>>& ring, const std::vector<int32_t>& region,
+                      std::vector<int32_t>& out) {
+  for (const auto& [w, d] : ring)
+    if (const int32_t r = region[w]; r >= 0 && std::find(out.begin(), out.end(), r) == out.end()) out.push_back(r);
+}
+
+// How the flats `near` meet around `ring`: their solid is the intersection
+// of their half-spaces (convex, +1) when the members in the ring lie inside
+// the other flats' planes, at least 3 to 1 (or when there is one flat), the
+// union (concave, -1) when outside, 3 to 1; else undecided (0). pos(w) is
+// member w's position (a Vec3, not an Eigen expression of temporaries),
+// height(f, p) the signed distance of p to flat f.
+template <class Pos, class Height>
+int crease_kind(const std::vector<std::pair<uint32_t, uint32_t>>& ring, const std::vector<int32_t>& region,
+                const std::vector<int32_t>& near, Pos pos, Height height) {
+  static_assert(std::is_same_v<std::invoke_result_t<Pos, uint32_t>, Vec3>, "pos must return a Vec3 by value");
+  size_t inside = 0, outside = 0;
+  for (const auto& [w, d] : ring)
+    if (const int32_t r = region[w]; r >= 0) {
+      const Vec3 x = pos(w);
+      for (int32_t f : near)
+        if (f != r) (height(f, x) < 0 ? inside : outside) += 1;
+    }
+  const bool convex = near.size() == 1 || inside >= 3 * outside;
+  const bool concave = near.size() > 1 && outside >= 3 * inside;
+  return convex == concave ? 0 : convex ? 1 : -1;
 }
 
 // Vertex adjacency of `n` vertices from triangles (CSR: the neighbours of v
