@@ -32,6 +32,7 @@ constexpr double kAdvance = 1e-3;  // cells: a cut-back round where no vertex ad
 // join_leftovers' marks of curved vertices that join a flat.
 constexpr uint8_t kLeftover = 1;  // joins and is projected onto the flat's plane
 constexpr uint8_t kStrip = 2;     // joins the label only (thin_strips)
+constexpr uint8_t kRimStrip = 3;  // in a strip's pocket next to a curved face (thin_strips)
 
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
 
@@ -92,6 +93,7 @@ struct Sharpener {
   std::vector<std::array<uint32_t, 2>> feature_edges;  // new edges between new vertices
   std::vector<int32_t> label;               // per original vertex: flat id or -1 (seg.region + leftovers)
   std::vector<uint32_t> leftovers;          // curved junction vertices that joined a flat
+  std::vector<uint8_t> junction;            // per original vertex: seg.junction, and the rim pockets' (join_leftovers)
   std::vector<int8_t> plane_state;          // per original vertex: 0 unknown, 1 has plane, -1 none
   std::vector<Plane> plane;
   detail::RingScratch rings;                // scratch of rings_around (tangent_plane, thin_strips)
@@ -125,7 +127,7 @@ struct Sharpener {
     std::vector<Vec3> pts;
     Vec3 outward = Vec3::Zero();
     for (const auto& [w, d] : rings.out)
-      if (!seg.junction[w]) {
+      if (!junction[w]) {
         pts.push_back(x[w]);
         outward[s.axis(w)] += s.lower_inside(w) ? 1 : -1;
       }
@@ -172,7 +174,7 @@ struct Sharpener {
       pts.clear();
       towards.setZero();
       for (uint32_t q : ring)
-        if (label[q] < 0 && (pass == 1 || !seg.junction[q])) {
+        if (label[q] < 0 && (pass == 1 || !junction[q])) {
           pts.push_back(x[q]);
           towards[s.axis(q)] += s.lower_inside(q) ? 1 : -1;
         }
@@ -192,7 +194,7 @@ struct Sharpener {
     if (a >= 0 && b >= 0) {
       return degrees_between(seg.flats[size_t(a)].normal, seg.flats[size_t(b)].normal) >= o.min_angle;
     }
-    return seg.junction[a < 0 ? u : v] != 0;
+    return junction[a < 0 ? u : v] != 0;
   }
 
   // Marks (kStrip) the curved vertices of thin strips: a vertex at most
@@ -207,6 +209,10 @@ struct Sharpener {
   // best). Strip vertices join a flat's label but are not projected onto
   // its plane: on the fandisk, whose flats include gently curved faces, the
   // projection cost more accuracy than it gained.
+  // A thin vertex with a curved vertex within `strip_rings` rings that is
+  // not thin itself is in a pocket of a flat's ragged rim next to a real
+  // curved face (kRimStrip), not in a strip between flats: join_leftovers
+  // lets it join only when the flat's plane crosses its stick.
   void thin_strips(std::vector<uint8_t>& mark) {
     const uint32_t W = uint32_t(std::max(0, o.strip_rings));
     if (W == 0) return;
@@ -222,12 +228,20 @@ struct Sharpener {
     }
     detail::spread_rings(std::move(front), 1, W + 1, adj_off, adj, depth,
                          [&](uint32_t, uint32_t w) { return label[w] < 0; });
+    std::vector<uint8_t> thin(n, 0);
     for (uint32_t v = 0; v < n; ++v) {
       if (label[v] >= 0 || mark[v] || depth[v] > W) continue;
       detail::rings_around(v, W, adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
-      bool thin = true;
-      for (const auto& [w, d] : rings.out) thin = thin && depth[w] <= W;
-      if (thin) mark[v] = kStrip;
+      bool ok = true;
+      for (const auto& [w, d] : rings.out) ok = ok && depth[w] <= W;
+      thin[v] = ok;
+    }
+    for (uint32_t v = 0; v < n; ++v) {
+      if (!thin[v]) continue;
+      detail::rings_around(v, W, adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
+      bool strip = true;
+      for (const auto& [w, d] : rings.out) strip = strip && (thin[w] || mark[w]);
+      mark[v] = strip || !o.rim_pockets ? kStrip : kRimStrip;
     }
   }
 
@@ -376,7 +390,7 @@ struct Sharpener {
     std::vector<uint32_t> ring;
     for (uint32_t v = 0; v < n; ++v) {
       Plane unused;
-      if (label[v] >= 0 || !(small[v] || (seg.junction[v] && !ring_plane(v, unused)))) continue;
+      if (label[v] >= 0 || !(small[v] || (junction[v] && !ring_plane(v, unused)))) continue;
       int32_t best = -1;
       double best_d = INFINITY;
       ring.assign(1, v);
@@ -391,9 +405,37 @@ struct Sharpener {
       }
       if (best >= 0) joins.push_back({v, best});
     }
+    // A rim pocket's vertex joins only when the flat's plane crosses its
+    // stick (up to 0.1 cell beyond either sample: a plane through a sample
+    // corner), and slides along the stick onto it, so no sample changes
+    // side. Otherwise it lies past the crease, on the curved face: left on
+    // the flat, off its plane, the crease vertex inserted next to it had to
+    // move back past it, which turned triangles over, and that move was
+    // cut back (CAD part 128: 100-170 crease vertices per seed, 0.3-0.5 cell
+    // off). It stays curved, and a junction when it has a flat and a
+    // curved junction neighbour (the border there is sharp).
+    std::vector<uint32_t> pocket;
     for (const auto& [v, f] : joins) {
+      if (small[v] == kRimStrip) {
+        const Vec3 in = s.inside_sample(v), out = s.outside_sample(v);
+        const double hi = height(f, in), ho = height(f, out);
+        const double t = ho != hi ? -hi / (ho - hi) : -1;
+        if (!(t > -0.1 && t < 1.1)) {
+          pocket.push_back(v);
+          continue;
+        }
+        x[v] = in + std::clamp(t, o.margin, 1 - o.margin) * (out - in);
+      }
       label[v] = f;
-      if (small[v] != kStrip) leftovers.push_back(v);  // a thin strip's vertices keep their place
+      if (small[v] == kLeftover) leftovers.push_back(v);  // a thin strip's vertices keep their place
+    }
+    for (uint32_t v : pocket) {
+      bool flat = false, sharp = false;
+      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+        flat |= label[adj[k]] >= 0;
+        sharp |= label[adj[k]] < 0 && seg.junction[adj[k]];
+      }
+      junction[v] |= flat && sharp;
     }
   }
 
@@ -695,6 +737,8 @@ struct Sharpener {
     plane_state.assign(n, 0);
     plane.resize(n);
     label = seg.region;
+    junction = seg.junction;
+    junction.resize(n, 0);
     if (!seg.flats.empty()) {
       snap_to_flats();
       join_leftovers();
@@ -762,11 +806,11 @@ struct Sharpener {
     if (s.lattice.flips_orientation())
       for (Triangle& t : m.triangles) std::swap(t[1], t[2]);
     MeshAttribute region{"region", ScalarType::i32, std::vector<double>(x.size(), -1)};
-    MeshAttribute junction{"junction", ScalarType::u8, std::vector<double>(x.size(), 0)};
+    MeshAttribute junction_flag{"junction", ScalarType::u8, std::vector<double>(x.size(), 0)};
     MeshAttribute feature{"feature", ScalarType::u8, std::vector<double>(x.size(), 0)};
     for (size_t v = 0; v < n; ++v) {
       region.values[v] = label[v];
-      junction.values[v] = seg.junction.empty() ? 0 : seg.junction[v];
+      junction_flag.values[v] = junction[v];
     }
     // Sharp feature edges: new edges whose edge vertex lies on a sharp crease.
     for (const auto& e : feature_edges) {
@@ -793,9 +837,9 @@ struct Sharpener {
       m.colors.resize(x.size());
       for (size_t v = 0; v < x.size(); ++v)
         m.colors[v] = feature.values[v] ? std::array<uint8_t, 4>{200, 20, 20, 255}
-                                        : region_color(int32_t(region.values[v]), junction.values[v] != 0);
+                                        : region_color(int32_t(region.values[v]), junction_flag.values[v] != 0);
     }
-    m.vertex_attributes = {std::move(region), std::move(junction), std::move(feature)};
+    m.vertex_attributes = {std::move(region), std::move(junction_flag), std::move(feature)};
     m.face_attributes = {std::move(face_region)};
     return m;
   }

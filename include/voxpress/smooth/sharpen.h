@@ -62,6 +62,11 @@ struct SharpenOptions {
   /// whose curved neighbours within as many rings are too, form a thin strip
   /// and join a flat (0: off).
   int strip_rings = 2;
+  /// Beyond the paper: a thin vertex in a pocket of a flat's rim next to a
+  /// real curved face joins the flat only when the flat's plane crosses its
+  /// stick, and then slides onto it; otherwise it stays curved, past the
+  /// crease (false: it joins like a strip vertex). See join_leftovers.
+  bool rim_pockets = true;
   /// Beyond the paper: a curved side's plane is the tangent plane of the
   /// quadric fitted to its fresh vertices within this many rings, when the
   /// fit's RMS residual is at most `curved_fit_residual` cells (0: the
