@@ -411,8 +411,8 @@ struct Sharpener {
     // side. Otherwise it lies past the crease, on the curved face: left on
     // the flat, off its plane, the crease vertex inserted next to it had to
     // move back past it, which turned triangles over, and that move was
-    // cut back (CAD part 128: 100-170 crease vertices per seed, 0.3-0.5 cell
-    // off). It stays curved, and a junction when it has a flat and a
+    // cut back (CAD part 128: 110-160 crease vertices per seed, left about
+    // 0.3 cell off the crease). It stays curved, and a junction when it has a flat and a
     // curved junction neighbour (the border there is sharp).
     std::vector<uint32_t> pocket;
     for (const auto& [v, f] : joins) {
