@@ -236,13 +236,20 @@ struct Sharpener {
       for (const auto& [w, d] : rings.out) ok = ok && depth[w] <= W;
       thin[v] = ok;
     }
-    for (uint32_t v = 0; v < n; ++v) {
-      if (!thin[v]) continue;
-      detail::rings_around(v, W, adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
-      bool strip = true;
-      for (const auto& [w, d] : rings.out) strip = strip && (thin[w] || mark[w]);
-      mark[v] = strip || !o.rim_pockets ? kStrip : kRimStrip;
+    // The curved vertices within W rings of one that is neither thin nor
+    // marked (ring distance over curved vertices is symmetric).
+    std::vector<uint32_t> near_deep(n, detail::kUnreached), deep;
+    if (o.rim_pockets) {
+      for (uint32_t v = 0; v < n; ++v)
+        if (label[v] < 0 && !thin[v] && !mark[v]) {
+          near_deep[v] = 0;
+          deep.push_back(v);
+        }
+      detail::spread_rings(std::move(deep), 0, W, adj_off, adj, near_deep,
+                           [&](uint32_t, uint32_t w) { return label[w] < 0; });
     }
+    for (uint32_t v = 0; v < n; ++v)
+      if (thin[v]) mark[v] = near_deep[v] == detail::kUnreached ? kStrip : kRimStrip;
   }
 
   // Calls f(patch) for each connected patch of curved vertices (label < 0).
