@@ -359,7 +359,12 @@ TEST(Flats, CreaseFitMakesTheCylinderRimMoreAccurate) {
 // curved side, its normal taken at the flat) must call that border smooth,
 // and keep the real creases (the cylinder's rim) sharp.
 TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
-  for (int seed = 1; seed <= 2; ++seed) {
+  // The boss stands on a 6-cell fillet tangent to the plate's top. Without
+  // the tangent test its foot is taken for a crease and labelled 20 voxels
+  // from any true one; with the residual bound at 0.08 cell one junction
+  // (fit residual 0.083-0.084) still labelled a spot 8-18 voxels off on
+  // seeds 2, 11 and 18 (docs/ARCHITECTURE.md, Flats: Tangent test).
+  for (int seed : {1, 2, 11, 18}) {
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
     const GeneratedShape g = rotated(ShapeKind::cad_part, 128, seed);
     Mesh tm = cad_part_mesh();
@@ -369,10 +374,6 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
     auto stray = [&](double tangent_residual) {
       SurfaceOptions so;
       so.flat.tangent_residual = tangent_residual;
-      // The junction test alone: sharpen's thin strips (beyond the paper)
-      // can label a few stray edges of their own (seed 2: a 5-sample spot on
-      // the fillet, 8 voxels off; docs/ARCHITECTURE.md, Sharp edges).
-      so.sharp.strip_rings = 0;
       const Mesh m = smooth_surface(g.volume, so).mesh;
       EvalOptions eo;
       eo.volume = &g.volume;
@@ -382,9 +383,8 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
       EXPECT_EQ(r.classification_violations.value_or(1), 0u);
       return r.sharp_labelled_to_true_vox.value_or(1e300);
     };
-    const double with = stray(FlatOptions{}.tangent_residual), without = stray(0);
-    EXPECT_GT(without, 15) << "the fillet is labelled without the test (measured 23.2, 20.1)";
-    EXPECT_LT(with, 5) << "measured 1.8, 3.6";
+    EXPECT_LT(stray(FlatOptions{}.tangent_residual), 1.5) << "measured 0.98, 0.92, 0.89, 0.85";
+    if (seed <= 2) EXPECT_GT(stray(0), 15) << "the fillet is labelled without the test (measured 23.2, 20.3)";
   }
 }
 

@@ -84,7 +84,7 @@ struct FlatOptions {
   /// away) fits a quadric within this RMS (cells), with the quadric's normal
   /// within junction_angle of the flat's where the vertex projects onto the
   /// flat, is a tangent (smooth) border, e.g. a fillet (0: off).
-  double tangent_residual = 0.08;
+  double tangent_residual = 0.1;
   double cone = 3;             ///< degrees: a vertex votes for directions within this of its normal
   double tolerance = 0.3;      ///< cells: core vertices lie this close to the plane (estimate)
   double max_bend = 5;         ///< degrees: largest normal change across a flat's core (linear fit)
