@@ -470,6 +470,15 @@ struct Detector {
   // caller keeps the result only when it is at least kRestabTrigger).
   double restab(std::vector<uint32_t>& core, Plane& P, bool force) {
     const double cos_window = std::cos(kRestabWindow * kPi / 180);
+    // Within kRestabRange of a lattice axis the share says little: the
+    // CAD part's end faces at 128^3 seed 15 lie 2 degrees off z and rise
+    // 1.1 cells across, so an axis-aligned plane through one terrace stabs
+    // 0.90-0.92 of their candidates (or, once a flat took that terrace, a
+    // plane through the next one 0.70) while lying up to half a cell off.
+    // Such a plane is always searched; the result is still kept only when
+    // it reaches kRestabTrigger. A face on the axis gains nothing from the
+    // search and keeps its plane.
+    const bool near_axis = P.n.cwiseAbs().maxCoeff() > std::cos(kRestabRange * kPi / 180);
     std::vector<uint32_t> cand, next;
     std::vector<Vec3> pts;
     for (int round = 0;; ++round) {
@@ -486,8 +495,8 @@ struct Detector {
       // Either way, a plane far from explaining it (next to a gently
       // curved face: 0.46-0.68 on fandisk; tilted box pieces: 0.82-0.89)
       // is not searched: that search would be wasted.
-      if ((round == 0 && (force ? share < kRestabTrigger : share >= kRestabTrigger)) || round == kRestabRounds ||
-          share < kRestabGiveUp)
+      if (round == kRestabRounds ||
+          (!near_axis && ((round == 0 && (force ? share < kRestabTrigger : share >= kRestabTrigger)) || share < kRestabGiveUp)))
         return share;
       Plane Q;
       size_t now = 0;

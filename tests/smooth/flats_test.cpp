@@ -222,10 +222,11 @@ TEST(Flats, RotatedCylinderHasTwoCapsAndACurvedWall) {
 }
 
 TEST(Flats, CadPartPlanarFacesFoundNoneSpurious) {
-  // seed 1 at 128 misses the chamfer (docs/BENCHMARKS.md): the pressed
-  // estimate rounds the 12-cell-wide face from both sides, so its core
-  // bends like a cylinder strip; it is asserted separately below.
-  for (int seed = 2; seed <= 4; ++seed) {
+  // Seed 15: the plate's two end faces lie 2 degrees off z; before near-axis
+  // planes were always searched (Detector::restab), axis-aligned planes
+  // through one terrace each were taken for them (6 faces, 2 spurious).
+  // Seed 1's chamfer was missed before the stabbing refit.
+  for (int seed : {1, 2, 3, 4, 15}) {
     SCOPED_TRACE("cad-part 128 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::cad_part, 128, seed);
     std::vector<int> found(r.faces.size(), 0);
@@ -238,13 +239,6 @@ TEST(Flats, CadPartPlanarFacesFoundNoneSpurious) {
       EXPECT_TRUE(found[i]) << "planar face " << i << " (area " << r.faces[i].area << ") not found";
     expect_guarantees(r.surface, r.seg, r.shape.volume);
   }
-  const FlatRun r = run(ShapeKind::cad_part, 128, 1);
-  size_t found = 0;
-  for (const Flat& f : r.seg.flats) {
-    ASSERT_GE(match(f, r.faces), 0) << "spurious flat";
-    ++found;
-  }
-  EXPECT_GE(found, r.faces.size() - 1);
 }
 
 TEST(Flats, OrganicShapesHaveNoFlats) {
@@ -384,7 +378,9 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
       return r.sharp_labelled_to_true_vox.value_or(1e300);
     };
     EXPECT_LT(stray(FlatOptions{}.tangent_residual), 1.5) << "measured 0.98, 0.92, 0.89, 0.85";
-    if (seed <= 2) EXPECT_GT(stray(0), 15) << "the fillet is labelled without the test (measured 23.2, 20.3)";
+    if (seed <= 2) {
+      EXPECT_GT(stray(0), 15) << "the fillet is labelled without the test (measured 23.2, 20.3)";
+    }
   }
 }
 
