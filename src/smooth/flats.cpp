@@ -44,7 +44,8 @@ constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
 // whose normal is within kRestabWindow degrees; searched when the plane stabs
-// less than kRestabTrigger of them (not below kRestabGiveUp), over directions
+// less than kRestabTrigger of them (not below kRestabGiveUp; a core the
+// acceptance tests refused, at least kRestabForced), over directions
 // within kRestabRange degrees (kRestabSteps coarse steps each way, then two
 // 5 x 5 grids 4 and 16 times finer), with at most kRestabSample sticks;
 // taken when it stabs kRestabGain x as many; at most kRestabRounds rounds.
@@ -54,6 +55,7 @@ constexpr int kRestabRings = 10;
 constexpr double kRestabWindow = 15;
 constexpr double kRestabTrigger = 0.9;
 constexpr double kRestabGiveUp = 0.75;
+constexpr double kRestabForced = 0.7;
 constexpr double kRestabRange = 4;
 constexpr int kRestabSteps = 4;
 constexpr size_t kRestabSample = 2000;
@@ -465,7 +467,7 @@ struct Detector {
   // kRestabGain as many, take its connected stabbed set as the core and
   // refit (least squares inside the feasible set, as always). Repeat while
   // the core grows. `force`: a core the acceptance tests refused, searched
-  // only when its plane already stabs kRestabTrigger of the candidates.
+  // only when its plane already stabs kRestabForced of the candidates.
   // Returns the share of the final candidates the final plane stabs (the
   // caller keeps the result only when it is at least kRestabTrigger).
   double restab(std::vector<uint32_t>& core, Plane& P, bool force) {
@@ -490,13 +492,18 @@ struct Detector {
       for (uint32_t v : cand) stabbed += !std::isnan(crossing(S, v, P, o.margin));
       const double share = double(stabbed) / double(cand.size());
       // Not forced (an accepted core), a plane that explains its
-      // neighbourhood stays; forced (a rejected core), one that does not is
-      // not rescued (it is not even searched: cylinders reject hundreds of cores).
-      // Either way, a plane far from explaining it (next to a gently
-      // curved face: 0.46-0.68 on fandisk; tilted box pieces: 0.82-0.89)
-      // is not searched: that search would be wasted.
+      // neighbourhood stays, and one far from explaining it (next to a
+      // gently curved face: 0.46-0.68 on fandisk) is not searched: the
+      // search would tilt it into that face. Forced (a rejected core), the
+      // plane is searched from kRestabForced: the CAD part's 45-degree
+      // chamfer at 128^3 seed 20 is rounded from both sides, its cores lean
+      // 3-4 degrees, are refused, and stab 0.70-0.74 (at 0.9 they were not
+      // searched, at 0.6 tori and fandisk at 256 paid 2-3x the detection
+      // time for nothing). Cylinders reject hundreds of tangent-strip cores,
+      // but a search only keeps what ends at kRestabTrigger.
       if (round == kRestabRounds ||
-          (!near_axis && ((round == 0 && (force ? share < kRestabTrigger : share >= kRestabTrigger)) || share < kRestabGiveUp)))
+          (!near_axis && ((round == 0 && (force ? share < kRestabForced : share >= kRestabTrigger)) ||
+                          share < (force ? kRestabForced : kRestabGiveUp))))
         return share;
       Plane Q;
       size_t now = 0;
