@@ -413,8 +413,10 @@ struct Sharpener {
       if (best >= 0) joins.push_back({v, best});
     }
     // A rim pocket's vertex joins only when the flat's plane crosses its
-    // stick (up to 0.1 cell beyond either sample: a plane through a sample
-    // corner), and slides along the stick onto it, so no sample changes
+    // stick from the inside sample to the outside one (up to 0.1 cell
+    // beyond either sample: a plane through a sample corner; a plane with
+    // the outside sample below it does not bound the solid there), and
+    // slides along the stick onto it, so no sample changes
     // side. Otherwise it lies past the crease, on the curved face: left on
     // the flat, off its plane, the crease vertex inserted next to it had to
     // move back past it, which turned triangles over, and that move was
@@ -426,7 +428,7 @@ struct Sharpener {
       if (small[v] == kRimStrip) {
         const Vec3 in = s.inside_sample(v), out = s.outside_sample(v);
         const double hi = height(f, in), ho = height(f, out);
-        const double t = ho != hi ? -hi / (ho - hi) : -1;
+        const double t = ho > hi ? -hi / (ho - hi) : -1;  // crossed outwards only
         if (!(t > -0.1 && t < 1.1)) {
           pocket.push_back(v);
           continue;
