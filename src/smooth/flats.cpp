@@ -18,6 +18,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -61,6 +62,17 @@ constexpr int kRestabSteps = 4;
 constexpr size_t kRestabSample = 2000;
 constexpr double kRestabGain = 1.02;
 constexpr int kRestabRounds = 6;
+// The low-index lattice directions, one of each +- pair: the 3 axes, the 6
+// face diagonals and the 4 body diagonals (restab's near-lattice search).
+const std::array<Vec3, 13> kLowIndex = [] {
+  std::array<Vec3, 13> d;
+  size_t k = 0;
+  for (int a = 0; a <= 1; ++a)
+    for (int b = -1; b <= 1; ++b)
+      for (int c = -1; c <= 1; ++c)
+        if ((a > 0 || b > 0 || (b == 0 && c > 0))) d[k++] = Vec3(a, b, c).normalized();
+  return d;
+}();
 
 // ---------------------------------------------------------------- directions
 // Equal-angle cube map: face (axis a, sign), the two other coordinates
@@ -472,15 +484,24 @@ struct Detector {
   // caller keeps the result only when it is at least kRestabTrigger).
   double restab(std::vector<uint32_t>& core, Plane& P, bool force) {
     const double cos_window = std::cos(kRestabWindow * kPi / 180);
-    // Within kRestabRange of a lattice axis the share says little: the
-    // CAD part's end faces at 128^3 seed 15 lie 2 degrees off z and rise
-    // 1.1 cells across, so an axis-aligned plane through one terrace stabs
-    // 0.90-0.92 of their candidates (or, once a flat took that terrace, a
-    // plane through the next one 0.70) while lying up to half a cell off.
-    // Such a plane is always searched; the result is still kept only when
-    // it reaches kRestabTrigger. A face on the axis gains nothing from the
-    // search and keeps its plane.
-    const bool near_axis = P.n.cwiseAbs().maxCoeff() > std::cos(kRestabRange * kPi / 180);
+    // Within kRestabRange of a low-index lattice direction (an axis, a face
+    // or a body diagonal) the share says little: the lattice's samples lie
+    // in layers across such a normal, so a plane tilted a little from it
+    // crosses few layers, and a plane along the direction through one of
+    // them stabs most of the face's sticks while lying up to half a cell
+    // off. The CAD part's end faces at 128^3 seed 15 lie 2 degrees off z
+    // and rise 1.1 cells across: an axis-aligned plane through one terrace
+    // stabbed 0.90-0.92 of their candidates (or, once a flat took that
+    // terrace, a plane through the next one 0.70); box 128 seed 48's face 1
+    // degree off a face diagonal left a 3-degree plane through one layer as
+    // a seventh flat. An accepted core's plane there is always searched; a
+    // refused core's still from kRestabForced (cylinders' tangent strips
+    // near a diagonal would cost their detection 80 % more). The result is
+    // still kept only when it reaches kRestabTrigger; a face on the
+    // direction gains nothing from the search and keeps its plane.
+    const double cos_range = std::cos(kRestabRange * kPi / 180);
+    const bool near_axis = std::any_of(kLowIndex.begin(), kLowIndex.end(),
+                                       [&](const Vec3& d) { return std::abs(P.n.dot(d)) > cos_range; });
     std::vector<uint32_t> cand, next;
     std::vector<Vec3> pts;
     for (int round = 0;; ++round) {
@@ -501,10 +522,9 @@ struct Detector {
       // searched, at 0.6 tori and fandisk at 256 paid 2-3x the detection
       // time for nothing). Cylinders reject hundreds of tangent-strip cores,
       // but a search only keeps what ends at kRestabTrigger.
-      if (round == kRestabRounds ||
-          (!near_axis && ((round == 0 && (force ? share < kRestabForced : share >= kRestabTrigger)) ||
-                          share < (force ? kRestabForced : kRestabGiveUp))))
-        return share;
+      const bool stop = force ? share < kRestabForced
+                              : !near_axis && ((round == 0 && share >= kRestabTrigger) || share < kRestabGiveUp);
+      if (round == kRestabRounds || stop) return share;
       Plane Q;
       size_t now = 0;
       const size_t best = most_stabbing(cand, P, Q, now);
