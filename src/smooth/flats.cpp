@@ -70,7 +70,7 @@ const std::array<Vec3, 13> kLowIndex = [] {
   for (int a = 0; a <= 1; ++a)
     for (int b = -1; b <= 1; ++b)
       for (int c = -1; c <= 1; ++c)
-        if ((a > 0 || b > 0 || (b == 0 && c > 0))) d[k++] = Vec3(a, b, c).normalized();
+        if (a > 0 || b > 0 || (b == 0 && c > 0)) d[k++] = Vec3(a, b, c).normalized();
   return d;
 }();
 
@@ -500,7 +500,7 @@ struct Detector {
     // still kept only when it reaches kRestabTrigger; a face on the
     // direction gains nothing from the search and keeps its plane.
     const double cos_range = std::cos(kRestabRange * kPi / 180);
-    const bool near_axis = std::any_of(kLowIndex.begin(), kLowIndex.end(),
+    const bool near_lattice = std::any_of(kLowIndex.begin(), kLowIndex.end(),
                                        [&](const Vec3& d) { return std::abs(P.n.dot(d)) > cos_range; });
     std::vector<uint32_t> cand, next;
     std::vector<Vec3> pts;
@@ -523,7 +523,7 @@ struct Detector {
       // time for nothing). Cylinders reject hundreds of tangent-strip cores,
       // but a search only keeps what ends at kRestabTrigger.
       const bool stop = force ? share < kRestabForced
-                              : !near_axis && ((round == 0 && share >= kRestabTrigger) || share < kRestabGiveUp);
+                              : !near_lattice && ((round == 0 && share >= kRestabTrigger) || share < kRestabGiveUp);
       if (round == kRestabRounds || stop) return share;
       Plane Q;
       size_t now = 0;
