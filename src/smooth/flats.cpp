@@ -45,8 +45,9 @@ constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
 // whose normal is within kRestabWindow degrees; searched when the plane stabs
-// less than kRestabTrigger of them (not below kRestabGiveUp; a core the
-// acceptance tests refused, at least kRestabForced), over directions
+// less than kRestabTrigger of them (not below kRestabGiveUp), or always when
+// it lies within kRestabRange of a low-index direction (kLowIndex); a core
+// the acceptance tests refused, when it stabs at least kRestabForced; over directions
 // within kRestabRange degrees (kRestabSteps coarse steps each way, then two
 // 5 x 5 grids 4 and 16 times finer), with at most kRestabSample sticks;
 // taken when it stabs kRestabGain x as many; at most kRestabRounds rounds.
