@@ -127,6 +127,7 @@ VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int 
   Mesh phys = model;
   for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
   VoxelizedModel out;
+  out.physical = phys;
   out.truth = mesh_truth(std::move(phys), file);
   out.volume = std::move(v.volume);
   return out;

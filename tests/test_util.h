@@ -50,6 +50,7 @@ std::string shared_data();
 /// caller checks that the shared data is present).
 struct VoxelizedModel {
   BinaryVolume volume;
+  Mesh physical;  ///< the model in the volume's physical frame
   std::unique_ptr<Truth> truth;
 };
 VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int seed);

@@ -42,6 +42,14 @@ constexpr int kNormalRings = 3;  // smoothing rounds of the estimated normals
 // 0.065; 0.1 and 0.2 found fewer faces on the CAD part at 64^3.
 constexpr double kGrowSlack = 0.05;
 constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
+// An accumulator cell seeds a cluster when it has at least this share of
+// min_area voters; the flat itself must still reach min_area after growth
+// (accept). Voters are the vertices whose estimated normal lies within the
+// cone of the cell's direction, so a face whose estimate its rounded edges
+// bend has far fewer voters than sticks: fandisk 128's two 570-cell side
+// faces had 46 in their best cell and were never tried with a share of 1
+// (docs/BENCHMARKS.md, Flats: seed threshold).
+constexpr double kSeedShare = 0.3;
 constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
 // whose normal is within kRestabWindow degrees; searched when the plane stabs
@@ -962,15 +970,14 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       if (cell_count[c] > 0) heap.push({cell_count[c], neg});
       continue;
     }
-    // A flat covers at most one cell area per stick, so fewer voters than
-    // min_area cannot make one: nothing left can.
-    if (double(cnt) < o.min_area) break;
+    // Too few voters to seed a cluster: nothing left can (kSeedShare).
+    if (double(cnt) < kSeedShare * o.min_area) break;
     ++seg.stats.tried;
     seeds.clear();
     for (uint32_t i = cell_begin[c]; i < cell_begin[c + 1]; ++i)
       if (seg.region[votes[i].voter] < 0) seeds.push_back(votes[i].voter);
     cell_count[c] = 0;  // used: accepted or not, this cell is done
-    if (double(seeds.size()) < o.min_area) continue;
+    if (double(seeds.size()) < kSeedShare * o.min_area) continue;
     Plane P;
     std::vector<uint32_t> rejected;
     const std::vector<uint32_t> members = det.cluster_from(seeds, P, rejected);
