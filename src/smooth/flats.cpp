@@ -46,9 +46,9 @@ constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 // min_area voters; the flat itself must still reach min_area after growth
 // (accept). Voters are the vertices whose estimated normal lies within the
 // cone of the cell's direction, so a face whose estimate its rounded edges
-// bend has far fewer voters than sticks: fandisk 128's two 570-cell side
+// bend has far fewer voters than sticks: fandisk 128's two 600-cell side
 // faces had 46 in their best cell and were never tried with a share of 1
-// (docs/BENCHMARKS.md, Flats: seed threshold).
+// (docs/ARCHITECTURE.md, Flats: Greedy extraction).
 constexpr double kSeedShare = 0.3;
 constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
