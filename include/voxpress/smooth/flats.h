@@ -25,7 +25,10 @@
 //     flat if its area is at least `min_area`, its width at least
 //     `min_width`, its normals' median angle to the plane's at most
 //     `max_spread` and their linear trend across it at most `max_bend`
-//     (these reject the strips where a plane is tangent to a curved surface).
+//     (these reject the strips where a plane is tangent to a curved surface),
+//     and, beyond the paper, if no quadric fitted to its neighbourhood stabs
+//     more than `curved_gain` times as many of the neighbourhood's sticks as
+//     the plane (a strip of a curved face the estimate could not reveal).
 //     The sticks of a flat leave the accumulator; the next best cell follows.
 //  4. Refine. The best-fitting plane (least squares of the cluster's
 //     estimated vertices) among those that stab every cluster stick with the
@@ -97,6 +100,12 @@ struct FlatOptions {
   /// estimate is a pillow); also rescues cores the spread and bend tests
   /// refused when that plane stabs 90 % of their neighbourhood.
   bool stab_refit = true;
+  /// Beyond the paper: a flat is refused when a quadric fitted to its
+  /// neighbourhood (10 rings, normals within 30 degrees) stabs more than
+  /// this many times as many of those sticks as its plane: a tangent strip
+  /// of a curved face, which the spread and bend tests pass when the face
+  /// is gently curved or a previous pass froze the strip (0: off).
+  double curved_gain = 1.3;
   /// Beyond the paper: refit the planes so that they also keep the samples
   /// of their sharp creases on the right side (faces nearly containing a
   /// lattice axis, whose own sticks leave their tilt loose).
