@@ -201,6 +201,7 @@ int main(int argc, char** argv) {
   app.add_option("--flat-spread", fo.max_spread);
   app.add_option("--flat-passes", fo.passes);
   app.add_flag("!--no-stab-refit", fo.stab_refit, "Without the flats' stabbing refit (near-axis faces)");
+  app.add_option("--merge-angle", fo.merge_angle, "Degrees: adjacent flats this close are merged when one plane stabs both (0: off)");
   app.add_option("--curved-gain", fo.curved_gain, "Flats' curvature test: refuse a flat a quadric out-stabs this many times (0: off)");
   app.add_flag("!--no-crease-refit", fo.crease_refit, "Without the flats' crease refit (their creases' samples as constraints)");
   CLI11_PARSE(app, argc, argv);

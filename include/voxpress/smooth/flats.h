@@ -94,7 +94,7 @@ struct FlatOptions {
   double max_spread = 1.4;     ///< degrees: largest median angle between a core normal and the plane's
   double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
   int rim_rings = 2;           ///< surface rings added around the core
-  double merge_angle = 3;      ///< degrees: adjacent flats this close are merged when one plane stabs both (0: off)
+  double merge_angle = 4;      ///< degrees: adjacent flats this close are merged when one plane stabs both (0: off)
   /// Beyond the paper: refit each core's plane by the count of sticks it
   /// stabs around it, not by the estimate (faces near a lattice axis, whose
   /// estimate is a pillow); also rescues cores the spread and bend tests
