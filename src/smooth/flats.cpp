@@ -495,21 +495,36 @@ struct Detector {
   // 0.060-0.064 to 0.055-0.057; the generated shapes are unchanged (1.2
   // would refuse the box piece: docs/ARCHITECTURE.md, Flats: Curvature test).
   bool curved(const std::vector<uint32_t>& core, const Plane& P) {
-    std::vector<uint32_t> ext = core;
-    const uint32_t m0 = ++stamp;
-    for (uint32_t v : ext) mark[v] = m0;
-    const double cos_window = std::cos(kCurvedWindow * kPi / 180);
-    grow(ext, 0, kCurvedRings, [&](uint32_t w) { return S.nrm[w].dot(P.n) >= cos_window; });
+    std::vector<uint32_t> ext;
+    neighbourhood(core, P, kCurvedRings, kCurvedWindow, ext);
     std::vector<Vec3> pts;
     S.positions(ext, pts);
     detail::Quadric Q;
     if (!Q.fit(pts, P.n)) return false;
-    size_t by_plane = 0, by_quadric = 0;
-    for (uint32_t v : ext) {
-      by_plane += !std::isnan(crossing(S, v, P, o.margin));
-      by_quadric += !std::isnan(Q.exit(S.inside(v), S.outside(v), 0.5, o.margin, 1 - o.margin));
-    }
-    return double(by_quadric) > o.curved_gain * double(by_plane);
+    size_t by_quadric = 0;
+    for (uint32_t v : ext) by_quadric += !std::isnan(Q.exit(S.inside(v), S.outside(v), 0.5, o.margin, 1 - o.margin));
+    return double(by_quadric) > o.curved_gain * double(stabbed_by(ext, P));
+  }
+
+  // The core and the unassigned vertices within `rings` rings of it whose
+  // estimated normal is within `window` degrees of the plane's, into `out`
+  // (restab's candidates, curved's neighbourhood). Returns the stamp they
+  // all carry in `mark`.
+  uint32_t neighbourhood(const std::vector<uint32_t>& core, const Plane& P, int rings, double window,
+                         std::vector<uint32_t>& out) {
+    const uint32_t m = ++stamp;
+    for (uint32_t v : core) mark[v] = m;
+    out = core;
+    const double cos_window = std::cos(window * kPi / 180);
+    grow(out, 0, rings, [&](uint32_t w) { return S.nrm[w].dot(P.n) >= cos_window; });
+    return m;
+  }
+
+  // How many of the sticks of `vs` the plane stabs (with the margin).
+  size_t stabbed_by(const std::vector<uint32_t>& vs, const Plane& P) const {
+    size_t k = 0;
+    for (uint32_t v : vs) k += !std::isnan(crossing(S, v, P, o.margin));
+    return k;
   }
 
   // Beyond the paper: the plane that stabs the most sticks around an
@@ -533,7 +548,6 @@ struct Detector {
   // Returns the share of the final candidates the final plane stabs (the
   // caller keeps the result only when it is at least kRestabTrigger).
   double restab(std::vector<uint32_t>& core, Plane& P, bool force) {
-    const double cos_window = std::cos(kRestabWindow * kPi / 180);
     // Within kRestabRange of a low-index lattice direction (an axis, a face
     // or a body diagonal) the share says little: the lattice's samples lie
     // in layers across such a normal, so a plane tilted a little from it
@@ -555,13 +569,8 @@ struct Detector {
     std::vector<uint32_t> cand, next;
     std::vector<Vec3> pts;
     for (int round = 0;; ++round) {
-      const uint32_t core_mark = ++stamp;
-      for (uint32_t v : core) mark[v] = core_mark;
-      cand = core;
-      grow(cand, 0, kRestabRings, [&](uint32_t w) { return S.nrm[w].dot(P.n) >= cos_window; });
-      size_t stabbed = 0;
-      for (uint32_t v : cand) stabbed += !std::isnan(crossing(S, v, P, o.margin));
-      const double share = double(stabbed) / double(cand.size());
+      const uint32_t core_mark = neighbourhood(core, P, kRestabRings, kRestabWindow, cand);
+      const double share = double(stabbed_by(cand, P)) / double(cand.size());
       // Not forced (an accepted core), a plane that explains its
       // neighbourhood stays, and one far from explaining it (next to a
       // gently curved face: 0.46-0.68 on fandisk) is not searched: the
@@ -604,8 +613,7 @@ struct Detector {
     const size_t stride = std::max<size_t>(1, cand.size() / kRestabSample);
     std::vector<uint32_t> use;
     for (size_t q = 0; q < cand.size(); q += stride) use.push_back(cand[q]);
-    now = 0;
-    for (uint32_t q : use) now += !std::isnan(crossing(S, q, P0, o.margin));
+    now = stabbed_by(use, P0);
     Vec3 u, v;
     frame(P0.n, u, v);
     struct Best {
