@@ -275,6 +275,8 @@ py::dict py_evaluate(const PyMesh& m, const std::string& truth, const py::object
     d["stick_rms_vox"] = e.stick_rms_vox ? py::object(py::float_(*e.stick_rms_vox)) : py::object(py::none());
   }
   if (e.sharp_edge_hausdorff) d["sharp_edge_hausdorff"] = *e.sharp_edge_hausdorff;
+  if (e.sharp_recall) d["sharp_recall"] = *e.sharp_recall;
+  if (e.sharp_precision) d["sharp_precision"] = *e.sharp_precision;
   d["mesh_ok"] = e.mesh.ok();
   return d;
 }

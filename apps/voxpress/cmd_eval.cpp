@@ -79,6 +79,12 @@ void run_eval(const EvalCmd& c, const Global& g) {
     std::printf("%-34s %12s   (%zu true sharp-edge segments, %zu labelled)\n", "sharp edges Hausdorff", "n/a",
                 r.true_sharp_edges, r.labelled_sharp_edges);
   }
+  if (r.sharp_recall)
+    std::printf("%-34s %11.1f %%  (of the true sharp curves' length, within %g voxel of a labelled one)\n",
+                "sharp edges recall", 100 * *r.sharp_recall, o.sharp_match_vox);
+  if (r.sharp_precision)
+    std::printf("%-34s %11.1f %%  (of the labelled curves' length, within %g voxel of a true one)\n",
+                "sharp edges precision", 100 * *r.sharp_precision, o.sharp_match_vox);
 
   if (!c.json.empty()) {
     nlohmann::json j;
@@ -114,7 +120,10 @@ void run_eval(const EvalCmd& c, const Global& g) {
                                       {"hausdorff", opt(r.sharp_edge_hausdorff)}}},
                         {"voxels", {{"true_to_labelled", opt(r.sharp_true_to_labelled_vox)},
                                     {"labelled_to_true", opt(r.sharp_labelled_to_true_vox)},
-                                    {"hausdorff", opt(r.sharp_edge_hausdorff_vox)}}}};
+                                    {"hausdorff", opt(r.sharp_edge_hausdorff_vox)},
+                                    {"recall", opt(r.sharp_recall)},
+                                    {"precision", opt(r.sharp_precision)},
+                                    {"match", o.sharp_match_vox}}}};
     j["seconds"] = clock.seconds();
     write_json(c.json, j);
   }

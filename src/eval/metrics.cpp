@@ -247,12 +247,19 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
         for (const Vec3& p : sgm) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
       step = (hi - lo).norm() / 1000;
     }
+    // Each sample point stands for length / (k + 1) of its segment: `share`
+    // is the length within o.sharp_match_vox voxels of the other set.
     auto directed = [&](const std::vector<std::array<Vec3, 2>>& from, const std::vector<std::array<Vec3, 2>>& to,
-                        double& phys, double& voxels) {
+                        double& phys, double& voxels, double& share) {
       std::vector<Vec3> pts;
+      std::vector<double> weight;
       for (const auto& sgm : from) {
-        const int k = std::max(1, int(std::ceil((sgm[1] - sgm[0]).norm() / step)));
-        for (int i = 0; i <= k; ++i) pts.push_back(sgm[0] + (sgm[1] - sgm[0]) * (double(i) / k));
+        const double len = (sgm[1] - sgm[0]).norm();
+        const int k = std::max(1, int(std::ceil(len / step)));
+        for (int i = 0; i <= k; ++i) {
+          pts.push_back(sgm[0] + (sgm[1] - sgm[0]) * (double(i) / k));
+          weight.push_back(len / (k + 1));
+        }
       }
       std::vector<double> dp(pts.size()), dv(pts.size());
       tbb::parallel_for(size_t(0), pts.size(), [&](size_t i) {
@@ -262,10 +269,16 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
       });
       phys = dp.empty() ? 0 : *std::max_element(dp.begin(), dp.end());
       voxels = dv.empty() ? 0 : *std::max_element(dv.begin(), dv.end());
+      double near = 0, total = 0;  // sequential: the same sum for any thread count
+      for (size_t i = 0; i < pts.size(); ++i) {
+        total += weight[i];
+        if (dv[i] <= o.sharp_match_vox) near += weight[i];
+      }
+      share = total > 0 ? near / total : 0;
     };
-    double tp = 0, tvx = 0, lp = 0, lv = 0;
-    directed(true_sharp, labelled, tp, tvx);
-    directed(labelled, true_sharp, lp, lv);
+    double tp = 0, tvx = 0, lp = 0, lv = 0, recall = 0, precision = 0;
+    directed(true_sharp, labelled, tp, tvx, recall);
+    directed(labelled, true_sharp, lp, lv, precision);
     r.sharp_true_to_labelled = tp;
     r.sharp_labelled_to_true = lp;
     r.sharp_edge_hausdorff = std::max(tp, lp);
@@ -273,7 +286,11 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
       r.sharp_true_to_labelled_vox = tvx;
       r.sharp_labelled_to_true_vox = lv;
       r.sharp_edge_hausdorff_vox = std::max(tvx, lv);
+      r.sharp_recall = recall;
+      r.sharp_precision = precision;
     }
+  } else if (vol && !true_sharp.empty()) {
+    r.sharp_recall = 0;  // nothing labelled: none of the true curves is found
   }
 
   MeshCheckOptions mo;

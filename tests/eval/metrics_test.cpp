@@ -146,6 +146,55 @@ TEST(Metrics, ScaledSphereHasTheAnalyticDistanceAndVolume) {
   EXPECT_GT(*r.classification_violations, 0u);  // the grown sphere swallows outside samples
 }
 
+TEST(Metrics, SharpRecallAndPrecisionMeasureLength) {
+  // A rotated box's 12 true sharp edges labelled on its midpoint surface:
+  // all of them (recall and precision 1), half of them (recall near 1/2,
+  // precision 1), all moved one voxel away (0 and 0), none (recall 0).
+  GenerateOptions o;
+  o.res = 40;
+  o.rotation = parse_rotation("random:3");
+  const GeneratedShape g = generate_shape(ShapeKind::box, o);
+  const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation);
+  const auto edges = truth->sharp_edges(30);
+  ASSERT_EQ(edges.size(), 12u);
+  const Mesh plain = to_mesh(extract_sticks(g.volume));
+  const Vec3 voxel_step = g.volume.lattice.index_to_physical_matrix() * Vec3(1, 1, 1);  // > 0.5 voxel from any edge
+  auto labelled = [&](size_t count, const Vec3& shift) {
+    Mesh m = plain;
+    for (size_t e = 0; e < count; ++e) {
+      const auto a = uint32_t(m.positions.size());
+      m.positions.push_back(edges[e][0] + shift);
+      m.positions.push_back(edges[e][1] + shift);
+      m.edges.push_back({a, a + 1});
+    }
+    EvalOptions eo;
+    eo.samples = 2000;
+    eo.volume = &g.volume;
+    eo.self_intersections = false;
+    return evaluate(m, *truth, eo);
+  };
+  const EvalReport all = labelled(12, Vec3::Zero());
+  ASSERT_TRUE(all.sharp_recall && all.sharp_precision);
+  EXPECT_NEAR(*all.sharp_recall, 1.0, 1e-12);
+  EXPECT_NEAR(*all.sharp_precision, 1.0, 1e-12);
+  double half_length = 0, total = 0;
+  for (size_t e = 0; e < 12; ++e) (e < 6 ? half_length : total) += (edges[e][1] - edges[e][0]).norm();
+  total += half_length;
+  const EvalReport half = labelled(6, Vec3::Zero());
+  // The unlabelled edges are matched only within half a voxel of the corners they share.
+  EXPECT_GT(*half.sharp_recall, half_length / total - 1e-9);
+  EXPECT_LT(*half.sharp_recall, half_length / total + 0.1);
+  EXPECT_NEAR(*half.sharp_precision, 1.0, 1e-12);
+  const EvalReport moved = labelled(12, voxel_step);
+  EXPECT_LT(*moved.sharp_recall, 0.05);
+  EXPECT_LT(*moved.sharp_precision, 0.05);
+  EXPECT_GT(*moved.sharp_edge_hausdorff_vox, 1.0);
+  const EvalReport none = labelled(0, Vec3::Zero());
+  ASSERT_TRUE(none.sharp_recall);
+  EXPECT_EQ(*none.sharp_recall, 0.0);
+  EXPECT_FALSE(none.sharp_precision);
+}
+
 TEST(Metrics, StickMetricIsExactForKnownParameters) {
   // Vertices placed at the true crossings score 0; shifted by 0.1 along
   // their sticks (towards the inside sample, still inside the stick) they score 0.1.

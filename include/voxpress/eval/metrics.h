@@ -16,7 +16,9 @@
 //     volume; the check_mesh verdict;
 //   * two-sided Hausdorff between the true sharp edges (dihedral angle above
 //     sharp_angle_deg) and the result's labelled sharp edges (Mesh::edges),
-//     both sampled every 0.1 cell.
+//     both sampled every 0.1 cell; with the volume, also the share of each
+//     set's length within sharp_match_vox voxels of the other (recall: of
+//     the true curves; precision: of the labelled ones).
 // Sampling is deterministic (seeded, counter-based) and parallel; the
 // numbers do not depend on the thread count.
 #pragma once
@@ -42,6 +44,7 @@ struct EvalOptions {
   size_t samples = 400000;                ///< area samples per direction
   uint64_t seed = 1;
   double sharp_angle_deg = 30;            ///< dihedral angle above which a true edge is sharp
+  double sharp_match_vox = 0.5;           ///< voxels: a sharp curve point this close to the other set is matched
   const BinaryVolume* volume = nullptr;   ///< enables the stick metric, voxel units and classification
   bool self_intersections = true;         ///< check_mesh's expensive part
   Progress* progress = nullptr;
@@ -67,6 +70,12 @@ struct EvalReport {
   /// empty. Physical units, and in voxels when the volume is known.
   std::optional<double> sharp_true_to_labelled, sharp_labelled_to_true, sharp_edge_hausdorff;
   std::optional<double> sharp_true_to_labelled_vox, sharp_labelled_to_true_vox, sharp_edge_hausdorff_vox;
+  /// With the volume: the share of the true sharp curves' length within
+  /// sharp_match_vox voxels of a labelled curve (recall), and of the
+  /// labelled curves' length within as much of a true one (precision).
+  /// The Hausdorff distance is one worst point; these say how much of the
+  /// feature network is found, and how much of what is labelled is real.
+  std::optional<double> sharp_recall, sharp_precision;
   std::string truth;
 };
 
