@@ -204,6 +204,7 @@ int main(int argc, char** argv) {
   app.add_option("--merge-angle", fo.merge_angle, "Degrees: adjacent flats this close are merged when one plane stabs both (0: off)");
   app.add_option("--curved-gain", fo.curved_gain, "Flats' curvature test: refuse a flat a quadric out-stabs this many times (0: off)");
   app.add_flag("!--no-crease-refit", fo.crease_refit, "Without the flats' crease refit (their creases' samples as constraints)");
+  app.add_flag("!--no-center", fo.center_planes, "Final planes by least squares of the estimate, not centred in their feasible set");
   CLI11_PARSE(app, argc, argv);
   struct Job {
     std::string shape, model;

@@ -12,6 +12,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include <Eigen/Cholesky>
@@ -270,6 +271,8 @@ struct SideConstraint {
 };
 constexpr double kSideMargin = 1e-6;  // cells: how strictly a SideConstraint's sample is on its side
 
+constexpr int kCenterRounds = 4;  // chord-midpoint sweeps of constrained_fit's centring
+
 // Section 3's plane refinement, our choice of "best": least squares inside
 // the feasible set. With n = n_F + a u + b v (n_F the least-squares normal
 // of the points, u, v orthonormal to it) and the plane n . (x - m) = c'
@@ -278,10 +281,12 @@ constexpr double kSideMargin = 1e-6;  // cells: how strictly a SideConstraint's 
 // margin" is two linear inequalities in z. With H = L L^T the residuals'
 // Hessian and w = L^T z this is the minimum-norm point of a polytope.
 // `sides` adds one-sided constraints (crease_refit), linear in z as well.
-// Returns false when the cluster is infeasible or the solver fails
+// With `center_within`, the plane then moves to the centre of the feasible
+// set (see there). Returns false when the cluster is infeasible or the solver fails
 // numerically (the caller keeps a feasible plane).
 bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, const std::vector<Vec3>& pts,
-                     const Vec3& towards, double margin, Plane& out, const std::vector<SideConstraint>& sides = {}) {
+                     const Vec3& towards, double margin, Plane& out, const std::vector<SideConstraint>& sides = {},
+                     const std::vector<uint32_t>* center_within = nullptr) {
   Vec3 m = Vec3::Zero();
   for (const Vec3& p : pts) m += p;
   m /= double(pts.size());
@@ -306,7 +311,7 @@ bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, con
   std::vector<double> B;
   A.reserve(2 * cluster.size());
   B.reserve(2 * cluster.size());
-  for (uint32_t s : cluster) {
+  auto add_stick = [&](uint32_t s) {
     // f(p) = n_F . (p - m) + phi(p) . z with phi(p) = (u . (p - m), v . (p - m), -1).
     const Vec3 pi = S.inside(s) - m, po = S.outside(s) - m;
     const Eigen::Vector3d phi_i(u.dot(pi), v.dot(pi), -1), phi_o(u.dot(po), v.dot(po), -1);
@@ -319,7 +324,8 @@ bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, con
     B.push_back(-k1);
     A.push_back(L.triangularView<Eigen::Lower>().solve(g2));
     B.push_back(-k2);
-  }
+  };
+  for (uint32_t s : cluster) add_stick(s);
   for (const SideConstraint& q : sides) {
     // outside: f(p) >= kSideMargin; inside: -f(p) >= kSideMargin.
     const Vec3 pq = q.p - m;
@@ -331,12 +337,48 @@ bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, con
   MinNorm qp(A, B);
   Eigen::Vector3d w;
   if (!qp.solve(w)) return false;
-  const Eigen::Vector3d z = L.transpose().triangularView<Eigen::Upper>().solve(w);
-  Plane P{F.n + z(0) * u + z(1) * v, 0};
-  P.c = z(2) + P.n.dot(m);
-  const double len = P.n.norm();
-  P.n /= len;
-  P.c /= len;
+  auto plane_of = [&](const Eigen::Vector3d& at) {
+    const Eigen::Vector3d z = L.transpose().triangularView<Eigen::Upper>().solve(at);
+    Plane P{F.n + z(0) * u + z(1) * v, 0};
+    P.c = z(2) + P.n.dot(m);
+    const double len = P.n.norm();
+    P.n /= len;
+    P.c /= len;
+    return P;
+  };
+  if (center_within) {
+    // Beyond the paper (FlatOptions::center_planes): from the least-squares
+    // plane to the centre of the feasible set, the sticks of `center_within`
+    // it stabs joining the constraints. Each step moves w to the midpoint of
+    // its chord through the polytope along one of seven fixed directions
+    // (whitened axes and diagonals); kCenterRounds sweeps.
+    const Plane P0 = plane_of(w);
+    const bool sorted = std::is_sorted(cluster.begin(), cluster.end());
+    for (uint32_t s : *center_within)
+      if (!(sorted && std::binary_search(cluster.begin(), cluster.end(), s)) && !std::isnan(crossing(S, s, P0, margin)))
+        add_stick(s);
+    for (int round = 0; round < kCenterRounds; ++round)
+      for (int d = 0; d < 7; ++d) {
+        const Eigen::Vector3d e = d < 3 ? Eigen::Vector3d::Unit(d)
+                                        : Eigen::Vector3d(1, (d & 1) ? 1 : -1, (d & 2) ? 1 : -1).normalized();
+        // The chord's ends (min / max: the same for any thread count).
+        using Range = std::pair<double, double>;
+        const Range chord = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, A.size(), 4096), Range{-1e300, 1e300},
+            [&](const tbb::blocked_range<size_t>& r, Range c) {
+              for (size_t i = r.begin(); i < r.end(); ++i) {
+                const double ae = A[i].dot(e), slack = std::max(0.0, A[i].dot(w) - B[i]);
+                if (ae > 1e-15) c.first = std::max(c.first, -slack / ae);
+                else if (ae < -1e-15) c.second = std::min(c.second, slack / -ae);
+              }
+              return c;
+            },
+            [](const Range& a, const Range& b) { return Range{std::max(a.first, b.first), std::min(a.second, b.second)}; });
+        const auto [lo, hi] = chord;
+        if (lo > -1e299 && hi < 1e299 && hi > lo) w += 0.5 * (lo + hi) * e;
+      }
+  }
+  const Plane P = plane_of(w);
   for (uint32_t s : cluster)
     if (std::isnan(crossing(S, s, P, margin))) return false;
   for (const SideConstraint& q : sides)
@@ -743,6 +785,9 @@ struct Detector {
 // the wrong side is refitted: least squares of its members near the plane,
 // inside the set stabbing all its members and keeping every constraint
 // (constrained_fit), taken when it moves less than kCreaseTurn degrees.
+// With FlatOptions::center_planes every flat is refitted in the first round
+// and its plane moved to the centre of that feasible set (every member the
+// least-squares plane stabs staying stabbed).
 // Rounds until no plane moves. Returns whether any moved.
 constexpr int kCreaseRings = 2;
 constexpr int kCreaseReach = 8;
@@ -832,7 +877,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
     }
     bool again = false;
     for (size_t f = 0; f < F; ++f) {
-      if (!broken[f]) continue;
+      if (!broken[f] && !(o.center_planes && round == 0)) continue;
       std::sort(sides[f].begin(), sides[f].end());
       sides[f].erase(std::unique(sides[f].begin(), sides[f].end()), sides[f].end());
       // Fitted: the members more than kCreaseRings rings from any other
@@ -848,7 +893,8 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       if (core.size() < 3) continue;
       S.positions(core, pts);
       Plane P;
-      if (!constrained_fit(S, inner, pts, planes[f].n, kSideMargin, P, sides[f])) continue;
+      if (!constrained_fit(S, inner, pts, planes[f].n, kSideMargin, P, sides[f], o.center_planes ? &members[f] : nullptr))
+        continue;
       if (std::acos(std::clamp(P.n.dot(planes[f].n), -1.0, 1.0)) * 180 / kPi > kCreaseTurn) continue;
       planes[f] = P;
       moved[f] = 1;

@@ -50,7 +50,9 @@
 //     the one plane it is not clearly inside of; concave the reverse); a
 //     plane that does not is refitted with them as one-sided constraints.
 //     This pins the tilt of faces nearly containing a lattice axis, which
-//     their own sticks leave loose.
+//     their own sticks leave loose. With `center_planes`, every plane is
+//     then moved to the centre of its feasible set (members and crease
+//     samples), not left where the least squares of the estimate put it.
 //
 // Junctions (Section 3): for an edge joining a frozen vertex of flat F and a
 // fresh vertex V, the normal of the least-squares plane of the fresh vertices
@@ -110,6 +112,13 @@ struct FlatOptions {
   /// of their sharp creases on the right side (faces nearly containing a
   /// lattice axis, whose own sticks leave their tilt loose).
   bool crease_refit = true;
+  /// Beyond the paper, with crease_refit: every final plane is refitted
+  /// once and moved from the least-squares plane to the centre of its
+  /// feasible set (its members and its creases' samples). The estimate the
+  /// least squares fit is itself smoothed and biased along the directions
+  /// the sticks leave loose (a face near a lattice plane); the centre is the
+  /// unbiased guess there and changes little elsewhere.
+  bool center_planes = true;
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
   int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
   /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
