@@ -25,6 +25,14 @@ Mesh box_mesh(const Mat3& rotate = Mat3::Identity(), const Vec3& shift = Vec3::Z
   return m;
 }
 
+// A generated shape at res^3 under the rotation `seed` (random:SEED).
+GeneratedShape rotated(ShapeKind kind, int64_t res, int seed) {
+  GenerateOptions o;
+  o.res = res;
+  o.rotation = parse_rotation("random:" + std::to_string(seed));
+  return generate_shape(kind, o);
+}
+
 TEST(Metrics, AMeshAgainstItselfIsExact) {
   const Mesh m = box_mesh();
   const auto truth = mesh_truth(m, "box");
@@ -150,10 +158,7 @@ TEST(Metrics, SharpRecallAndPrecisionMeasureLength) {
   // A rotated box's 12 true sharp edges labelled on its midpoint surface:
   // all of them (recall and precision 1), half of them (recall near 1/2,
   // precision 1), all moved one voxel away (0 and 0), none (recall 0).
-  GenerateOptions o;
-  o.res = 40;
-  o.rotation = parse_rotation("random:3");
-  const GeneratedShape g = generate_shape(ShapeKind::box, o);
+  const GeneratedShape g = rotated(ShapeKind::box, 40, 3);
   const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation);
   const auto edges = truth->sharp_edges(30);
   ASSERT_EQ(edges.size(), 12u);
@@ -198,10 +203,7 @@ TEST(Metrics, SharpRecallAndPrecisionMeasureLength) {
 TEST(Metrics, StickMetricIsExactForKnownParameters) {
   // Vertices placed at the true crossings score 0; shifted by 0.1 along
   // their sticks (towards the inside sample, still inside the stick) they score 0.1.
-  GenerateOptions o;
-  o.res = 48;
-  o.rotation = parse_rotation("random:4");
-  const GeneratedShape g = generate_shape(ShapeKind::torus, o);
+  const GeneratedShape g = rotated(ShapeKind::torus, 48, 4);
   const auto truth = shape_truth(ShapeKind::torus, g.linear, g.translation);
   StickSurface s = extract_sticks(g.volume);
   for (size_t i = 0; i < s.stick_count(); ++i) {
@@ -227,10 +229,7 @@ TEST(Metrics, MidpointRowOfThePaperIsReproduced) {
   // Pressing, Table 2, "Midpoint": 0.2837 - 0.2887 on randomly rotated models
   // (for uniformly distributed crossings the expected value is sqrt(1/12) = 0.2887).
   for (ShapeKind k : all_shapes()) {
-    GenerateOptions o;
-    o.res = 128;
-    o.rotation = parse_rotation("random:21");
-    const GeneratedShape g = generate_shape(k, o);
+    const GeneratedShape g = rotated(k, 128, 21);
     EvalOptions eo;
     eo.volume = &g.volume;
     eo.samples = 20000;
@@ -270,10 +269,7 @@ TEST(Metrics, MidpointRowOnFandisk) {
 }
 
 TEST(Metrics, DeterministicForAnyThreadCount) {
-  GenerateOptions o;
-  o.res = 40;
-  o.rotation = parse_rotation("random:8");
-  const GeneratedShape g = generate_shape(ShapeKind::cylinder, o);
+  const GeneratedShape g = rotated(ShapeKind::cylinder, 40, 8);
   const Mesh m = to_mesh(extract_sticks(g.volume));
   const auto truth = shape_truth(ShapeKind::cylinder, g.linear, g.translation);
   EvalOptions eo;
