@@ -75,8 +75,9 @@ size_t curved_vertices(const Sharpened& r) {
 TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
   // Seeds 8 and 21 need the snapping's tolerance of samples a hair outside
   // a face (solid_crossing), 29 the flats' crease refit (0.33 / 0.18 / 0.41
-  // before).
-  for (int seed : {1, 2, 3, 8, 21, 29}) {
+  // before), 39 and 48 the snapping's wider look for a corner's third flat
+  // (0.93 / 4.6 before).
+  for (int seed : {1, 2, 3, 8, 21, 29, 39, 48}) {
     SCOPED_TRACE("box 128 seed " + std::to_string(seed));
     const GeneratedShape g = shape(ShapeKind::box, 128, seed);
     const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation);
@@ -89,7 +90,7 @@ TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
     EXPECT_GE(r.stats.corners, 8u) << "at least one corner vertex per box corner";
     ASSERT_TRUE(after.sharp_edge_hausdorff_vox.has_value());
     // The target: true and labelled edges within 0.15 voxel both
-    // ways (all of seeds 1-30 meet it, the worst 0.13, docs/BENCHMARKS.md).
+    // ways (48 of seeds 1-50 meet it, the worst of those 0.13, docs/BENCHMARKS.md).
     EXPECT_LT(*after.sharp_edge_hausdorff_vox, 0.15);
     // Every original vertex ends on a flat: no bevel is left curved.
     ASSERT_NE(r.after.vertex_attribute("region"), nullptr);

@@ -9,8 +9,9 @@
 //     stopped short of, recognised because the flats' own solid (their
 //     half-spaces intersected at a convex crease, united at a concave one)
 //     crosses their sticks, slide along their sticks onto the flats
-//     (`snap_rings`, `snap_tolerance`, `snap_share`); a curved face's
-//     sticks lie outside that solid and stay.
+//     (`snap_rings`, `snap_tolerance`, `snap_share`; a patch at least half
+//     explained retries the rest with twice the rings, for a corner's third
+//     flat); a curved face's sticks lie outside that solid and stay.
 //  1. Chamfer edges join vertices of two different regions (two flats, or a
 //     flat and a curved junction vertex); smooth flat/curved borders (no
 //     junction) and flats meeting at less than `min_angle` are left alone.
