@@ -61,6 +61,22 @@ int match(const Flat& f, const std::vector<PlanarFace>& faces) {
   return -1;
 }
 
+// How many flats match each face (match()), and how many match none.
+struct Matches {
+  std::vector<int> per_face;
+  size_t unmatched = 0;
+};
+Matches match_all(const std::vector<Flat>& flats, const std::vector<PlanarFace>& faces) {
+  Matches m;
+  m.per_face.assign(faces.size(), 0);
+  for (const Flat& f : flats) {
+    const int k = match(f, faces);
+    if (k < 0) ++m.unmatched;
+    else ++m.per_face[size_t(k)];
+  }
+  return m;
+}
+
 // Every guarantee of the output: closed, manifold, oriented, no sample on
 // the wrong side; frozen vertices exactly on their planes.
 void expect_guarantees(const StickSurface& s, const FlatSegmentation& seg, const BinaryVolume& v) {
@@ -80,27 +96,19 @@ void expect_guarantees(const StickSurface& s, const FlatSegmentation& seg, const
 // A box's run: exactly six flats, one per face, every guarantee kept.
 void expect_six_faces(const FlatRun& r) {
   ASSERT_EQ(r.seg.flats.size(), 6u);
-  std::vector<int> used(6, 0);
-  for (const Flat& f : r.seg.flats) {
-    const int k = match(f, r.faces);
-    ASSERT_GE(k, 0) << "a flat matches no face of the box";
-    ++used[size_t(k)];
-  }
-  for (int u : used) EXPECT_EQ(u, 1) << "each face is found once";
+  const Matches m = match_all(r.seg.flats, r.faces);
+  ASSERT_EQ(m.unmatched, 0u) << "a flat matches no face of the box";
+  for (int u : m.per_face) EXPECT_EQ(u, 1) << "each face is found once";
   expect_guarantees(r.surface, r.seg, r.shape.volume);
 }
 
 // The CAD part's run: every planar face found, no flat matching none, every
 // guarantee kept.
 void expect_cad_faces(const FlatRun& r) {
-  std::vector<int> found(r.faces.size(), 0);
-  for (const Flat& f : r.seg.flats) {
-    const int k = match(f, r.faces);
-    ASSERT_GE(k, 0) << "spurious flat";
-    found[size_t(k)] = 1;
-  }
+  const Matches m = match_all(r.seg.flats, r.faces);
+  ASSERT_EQ(m.unmatched, 0u) << "spurious flat";
   for (size_t i = 0; i < r.faces.size(); ++i)
-    EXPECT_TRUE(found[i]) << "planar face " << i << " (area " << r.faces[i].area << ") not found";
+    EXPECT_GE(m.per_face[i], 1) << "planar face " << i << " (area " << r.faces[i].area << ") not found";
   expect_guarantees(r.surface, r.seg, r.shape.volume);
 }
 
@@ -125,14 +133,11 @@ TEST(Flats, RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats) {
   for (int seed = 1; seed <= 30; ++seed) {
     SCOPED_TRACE("box 64 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::box, 64, seed);
-    std::vector<int> used(6, 0);
-    size_t bad = 0;
-    for (const Flat& f : r.seg.flats) {
-      const int k = match(f, r.faces);
-      if (k < 0 || used[size_t(k)]++) ++bad;
-    }
+    const Matches m = match_all(r.seg.flats, r.faces);
+    size_t bad = m.unmatched;  // flats matching no face, or a face already taken
+    for (int u : m.per_face) bad += size_t(std::max(u - 1, 0));
     exact += r.seg.flats.size() == 6 && bad == 0;
-    found += size_t(std::count_if(used.begin(), used.end(), [](int u) { return u > 0; }));
+    found += size_t(std::count_if(m.per_face.begin(), m.per_face.end(), [](int u) { return u > 0; }));
     spurious += bad;
     expect_guarantees(r.surface, r.seg, r.shape.volume);
   }
@@ -163,10 +168,9 @@ TEST(Flats, FacesNearALatticeAxisAreFound) {
     SCOPED_TRACE("box " + std::to_string(res) + " seed " + std::to_string(seed));
     expect_six_faces(run(ShapeKind::box, res, seed));
     const FlatRun r = run(ShapeKind::box, res, seed, off);
-    std::vector<int> found(r.faces.size(), 0);
-    for (const Flat& f : r.seg.flats)
-      if (const int k = match(f, r.faces); k >= 0) found[size_t(k)] = 1;
-    const bool six = std::count(found.begin(), found.end(), 1) == 6 && r.seg.flats.size() == 6;
+    const Matches m = match_all(r.seg.flats, r.faces);
+    const bool six = std::count_if(m.per_face.begin(), m.per_face.end(), [](int u) { return u > 0; }) == 6 &&
+                     r.seg.flats.size() == 6;
     EXPECT_FALSE(six) << "without the refit this case no longer fails: pick another";
   }
 }
@@ -238,11 +242,8 @@ TEST(Flats, FaceSplitInTwoFlatsIsMerged) {
   no_merge.merge_angle = 0;
   const FlatRun split = run(ShapeKind::cad_part, 64, 50, no_merge);
   const FlatRun r = run(ShapeKind::cad_part, 64, 50, merge);
-  auto unmatched = [](const FlatRun& f) {
-    return std::count_if(f.seg.flats.begin(), f.seg.flats.end(), [&](const Flat& fl) { return match(fl, f.faces) < 0; });
-  };
-  EXPECT_GT(unmatched(split), 0) << "the case no longer splits a face: pick another";
-  EXPECT_EQ(unmatched(r), 0);
+  EXPECT_GT(match_all(split.seg.flats, split.faces).unmatched, 0u) << "the case no longer splits a face: pick another";
+  EXPECT_EQ(match_all(r.seg.flats, r.faces).unmatched, 0u);
   EXPECT_LT(r.seg.flats.size(), split.seg.flats.size());
   expect_guarantees(r.surface, r.seg, r.shape.volume);
   const auto truth = shape_truth(r.shape.kind, r.shape.linear, r.shape.translation);
@@ -303,7 +304,7 @@ TEST(Flats, CadPartAt256FoundNoneSpurious) {
     if (seed == 3) off.curved_gain = 0;
     else off.merge_angle = 3;
     const FlatRun r = run(ShapeKind::cad_part, shape, off);
-    EXPECT_TRUE(std::any_of(r.seg.flats.begin(), r.seg.flats.end(), [&](const Flat& f) { return match(f, r.faces) < 0; }))
+    EXPECT_GT(match_all(r.seg.flats, r.faces).unmatched, 0u)
         << "without " << without << " this case no longer has a spurious flat: pick another";
   }
 }
@@ -541,13 +542,9 @@ TEST(Flats, FandiskPlanarFacesFoundAndStagesBeatTheMidpoint) {
   for (const PlanarFace& f : planar_faces(v.physical, 0.5, 0.02))
     if (f.area >= 500) faces.push_back(f);
   EXPECT_GE(faces.size(), 7u);
-  std::vector<int> found(faces.size(), 0);
-  for (const Flat& f : seg.flats) {
-    const int k = match(f, faces);
-    if (k >= 0) found[size_t(k)] = 1;
-  }
+  const Matches m = match_all(seg.flats, faces);
   for (size_t i = 0; i < faces.size(); ++i)
-    EXPECT_TRUE(found[i]) << "planar face of " << faces[i].area << " cells, normal " << faces[i].normal.transpose();
+    EXPECT_GE(m.per_face[i], 1) << "planar face of " << faces[i].area << " cells, normal " << faces[i].normal.transpose();
   EXPECT_LT(e_tiles, 0.25);
   EXPECT_LT(*final_report.stick_rms_vox, e_tiles);
   EXPECT_EQ(final_report.classification_violations.value_or(1), 0u);
