@@ -119,7 +119,10 @@ std::string shared_data() {
 }
 
 VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int seed) {
-  const Mesh model = read_mesh(shared_data() + "/meshes/" + file);
+  return voxelized_model(read_mesh(shared_data() + "/meshes/" + file), file, res, seed);
+}
+
+VoxelizedModel voxelized_model(const Mesh& model, const std::string& name, int64_t res, int seed) {
   VoxelizeOptions vo;
   vo.res = res;
   vo.rotation = parse_rotation("random:" + std::to_string(seed));
@@ -128,7 +131,7 @@ VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int 
   for (Vec3& p : phys.positions) p = v.placement.translation + v.placement.linear * p;
   VoxelizedModel out;
   out.physical = phys;
-  out.truth = mesh_truth(std::move(phys), file);
+  out.truth = mesh_truth(std::move(phys), name);
   out.volume = std::move(v.volume);
   return out;
 }

@@ -54,6 +54,8 @@ struct VoxelizedModel {
   std::unique_ptr<Truth> truth;
 };
 VoxelizedModel voxelized_shared_model(const std::string& file, int64_t res, int seed);
+/// The same for a model built by the test (`name` labels its truth).
+VoxelizedModel voxelized_model(const Mesh& model, const std::string& name, int64_t res, int seed);
 
 /// Deterministic generator (splitmix64), independent of the standard library.
 class Rng {

@@ -55,6 +55,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"corner_vertices", st.corners},
           {"fallbacks", st.fallbacks},
           {"tangent_planes", st.tangent_planes},
+          {"wall_vertices", st.wall_vertices},
           {"snapped", st.snapped},
           {"cut_back", st.cut_back},
           {"sharp_edges", st.sharp_edges},
@@ -88,10 +89,10 @@ void run_press(const PressCmd& c, const Global& g) {
   so.method = parse_method(c.method);
   const bool pressing = so.method == Method::pressing;
   if (!pressing)
-    for (const char* name : {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend",
-                             "--flat-width", "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations",
-                             "--features", "--step", "--arc-length", "--margin", "--levels", "--momentum",
-                             "--weighting", "--plain"})
+    for (const char* name :
+         {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend", "--flat-width",
+          "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations", "--wall-thickness", "--features",
+          "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
   if (!c.features.empty()) {
     const MeshFormat ff = mesh_format_from_path(c.features);
@@ -214,6 +215,11 @@ void register_press(CLI::App& app, Global& g) {
   sh->add_option("--chain-iterations", c->sharpen.chain_iterations, "Bilaplacian iterations along the sharp curves")
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
+  sh->add_option("--wall-thickness", c->sharpen.wall_thickness,
+                 "Cells: the rim of a plate at most this thick (between two opposite flats) gets its own plane, so "
+                 "both its edges are sharpened (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 64.0));
   sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");

@@ -83,6 +83,11 @@ struct SharpenOptions {
   int snap_rings = 8;
   double snap_tolerance = 0.05;
   double snap_share = 0.95;
+  /// Beyond the paper: the rim of a plate at most this many cells thick (a
+  /// wall between two nearly opposite flats) gets its own plane, the widest
+  /// separator of its sticks' samples, so both its edges are sharpened (0:
+  /// off). See fit_walls in sharpen.cpp.
+  double wall_thickness = 12;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -94,6 +99,7 @@ struct SharpenStats {
   size_t fallbacks = 0;               ///< new vertices left where inserted (parallel planes, far solution, no plane)
   size_t snapped = 0;                 ///< original vertices slid along their sticks onto a flat (snap_to_flats)
   size_t tangent_planes = 0;          ///< curved sides whose plane is their quadric's tangent plane
+  size_t wall_vertices = 0;           ///< vertices given a thin wall's plane (fit_walls)
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
