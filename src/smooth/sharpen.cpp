@@ -474,21 +474,25 @@ struct Sharpener {
   // over fresh vertices, from members of two flats A, B whose normals are at
   // least 170 degrees apart (a plate's faces; 150 also took fandisk's curved
   // faces between its two nearly opposite sides), and lying between their
-  // planes at most `wall_thickness` cells apart, is on such a wall. Its plane: the widest
-  // separator of the inside samples of the sticks of the wall vertices in its
-  // 1-ring (its own included) from those sticks' outside samples that lie
-  // between A's and B's planes (outside because of the wall, not of a flat):
-  // a maximum-margin line in the plane perpendicular to A's normal, searched
-  // over its angle, c in the middle of the margin (the centre of the
-  // feasible set, like the flats' centring). The pressed rim is no guide:
+  // planes at most `wall_thickness` cells apart, is on such a wall. Its
+  // plane: the widest separator of the inside samples of the sticks of the
+  // wall vertices within 2 rings (over wall vertices) from those sticks'
+  // outside samples that lie between A's and B's planes (outside because of
+  // the wall, not of a flat): a maximum-margin line in the plane
+  // perpendicular to A's normal, searched over its angle, c in the middle of
+  // the margin (the centre of the feasible set, like the flats' centring).
+  // Where no line separates them (the rim turns: the tray's corners, small
+  // holes) the 1-ring's samples are used. The pressed rim is no guide:
   // squeezed between the flats, its vertices sit up to a cell inside. The
   // vertex then slides along its stick onto that plane when its own outside
   // sample is between A and B, and becomes a curved junction whose plane is
   // the wall's, so the chamfers on both sides cut along wall ∩ A and wall ∩
-  // B. Fits over 2 or 3 rings were measured worse (the rim turns at the
-  // tray's corners and around holes).
+  // B. Fixed 2- or 3-ring fits were measured worse than 1 ring (their
+  // infeasible fits left vertices out); 3 rings first, then 2 and 1, is no
+  // better than 2 then 1 (docs/ARCHITECTURE.md).
   void fit_walls() {
     if (!(o.wall_thickness > 0)) return;
+    constexpr uint32_t kWallFitRings = 2;
     const double opposite = std::cos(170 * kPi / 180);
     // The flats (up to kNear, smallest ids) that reach each fresh vertex over
     // fresh vertices within the thickness plus 2 rings: Jacobi rounds, so
@@ -540,21 +544,13 @@ struct Sharpener {
     }
     std::vector<Plane> wall(cand.size());
     std::vector<uint8_t> ok(cand.size(), 0);
+    tbb::enumerable_thread_specific<detail::RingScratch> scratch;
     tbb::parallel_for(size_t(0), cand.size(), [&](size_t k) {
       const uint32_t v = cand[k];
       const auto [A, B] = pair[v];
       const Vec3 na = seg.flats[size_t(A)].index_normal.normalized();
       const Vec3 u = na.cross(std::abs(na.x()) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)).normalized(), w = na.cross(u);
       std::vector<Eigen::Vector2d> in, out;
-      auto take = [&](uint32_t q) {
-        const Vec3 pi = s.inside_sample(q), po = s.outside_sample(q);
-        in.emplace_back(u.dot(pi), w.dot(pi));
-        if (height(A, po) < 0 && height(B, po) < 0) out.emplace_back(u.dot(po), w.dot(po));
-      };
-      take(v);
-      for (uint32_t i = adj_off[v]; i < adj_off[v + 1]; ++i)
-        if (pair[adj[i]] == pair[v]) take(adj[i]);
-      if (in.size() < 3 || out.size() < 3) return;
       double lo = 0, hi = 0;
       auto margin = [&](double a) {
         const Eigen::Vector2d d(std::cos(a), std::sin(a));
@@ -564,20 +560,33 @@ struct Sharpener {
         for (const auto& p : out) hi = std::min(hi, d.dot(p));
         return hi - lo;
       };
-      double best = -INFINITY, best_a = 0;
-      for (int i = 0; i < 180; ++i) {  // every 2 degrees, then halving steps
-        const double a = 2 * kPi * i / 180, m = margin(a);
-        if (m > best) best = m, best_a = a;
-      }
-      for (double step = kPi / 180; step > 1e-4; step /= 2)
-        for (const double a : {best_a - step, best_a + step}) {
-          const double m = margin(a);
+      detail::RingScratch& rs = scratch.local();
+      for (uint32_t rings_fit = kWallFitRings; rings_fit >= 1; --rings_fit) {
+        in.clear();
+        out.clear();
+        detail::rings_around(v, rings_fit, adj_off, adj, [&](uint32_t q) { return pair[q] == pair[v]; }, rs);
+        for (const auto& [q, d] : rs.out) {
+          const Vec3 pi = s.inside_sample(q), po = s.outside_sample(q);
+          in.emplace_back(u.dot(pi), w.dot(pi));
+          if (height(A, po) < 0 && height(B, po) < 0) out.emplace_back(u.dot(po), w.dot(po));
+        }
+        if (in.size() < 3 || out.size() < 3) continue;
+        double best = -INFINITY, best_a = 0;
+        for (int i = 0; i < 180; ++i) {  // every 2 degrees, then halving steps
+          const double a = 2 * kPi * i / 180, m = margin(a);
           if (m > best) best = m, best_a = a;
         }
-      if (!(best > 0)) return;
-      margin(best_a);
-      wall[k] = {std::cos(best_a) * u + std::sin(best_a) * w, 0.5 * (lo + hi)};
-      ok[k] = 1;
+        for (double step = kPi / 180; step > 1e-4; step /= 2)
+          for (const double a : {best_a - step, best_a + step}) {
+            const double m = margin(a);
+            if (m > best) best = m, best_a = a;
+          }
+        if (!(best > 0)) continue;  // no line separates them: the rim turns here
+        margin(best_a);
+        wall[k] = {std::cos(best_a) * u + std::sin(best_a) * w, 0.5 * (lo + hi)};
+        ok[k] = 1;
+        return;
+      }
     });
     std::vector<uint8_t> is_wall(n, 0);
     for (size_t k = 0; k < cand.size(); ++k) {
