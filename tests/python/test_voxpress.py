@@ -110,6 +110,24 @@ def test_bad_arguments_raise_clear_exceptions():
     assert issubclass(voxpress.InputError, voxpress.Error)
 
 
+def test_wall_thickness_reaches_the_sharpening():
+    # A tilted plate 3 cells thick: its rim lies between two opposite flats.
+    i, j, k = np.indices((56, 56, 56)).astype(float) - 27.6
+    n = np.array([0.25, 0.15, 1.0]) / np.linalg.norm([0.25, 0.15, 1.0])
+    u = np.cross(n, [1.0, 0, 0])
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    h = n[0] * i + n[1] * j + n[2] * k
+    a = u[0] * i + u[1] * j + u[2] * k
+    b = w[0] * i + w[1] * j + w[2] * k
+    plate = (np.abs(h) < 1.5) & (np.abs(a) < 20) & (np.abs(b) < 14)
+    walls, flat = voxpress.press(plate), voxpress.press(plate, wall_thickness=0)
+    assert walls.stats["flats"] >= 2
+    assert not np.array_equal(walls.vertices[: len(flat.vertices)], flat.vertices)
+    for mesh in (walls, flat):
+        assert voxpress.check(mesh, plate)["classification_violations"] == 0
+
+
 def test_mesh_outputs_and_evaluation(tmp_path):
     vol = tmp_path / "box.nrrd"
     cli("generate", "box", "--res", 48, "--rotate", "random:2", "-o", vol)
