@@ -23,7 +23,7 @@ cmake --build "$root/build-asan" -j "$(nproc)" --target "${suites[@]}" >&2
 # Release above.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndGuaranteesHold:Sharpen.ThinStripsAndTangentPlanesPlaceTheCreases:Sharpen.RotatedBoxesGetTheirEdgesBack:\
-Sharpen.SharpAngleOptionControlsTheLabels:Flats.RotatedBoxesHaveExactlySixFlatsWithinOneDegree:\
+Sharpen.SharpAngleOptionControlsTheLabels:Sharpen.ThinPlatesGetBothEdgesOfTheirRim:Flats.RotatedBoxesHaveExactlySixFlatsWithinOneDegree:\
 Flats.CadPartPlanarFacesFoundNoneSpurious:Flats.CadPartAt256FoundNoneSpurious:Flats.RotatedCylinderHasTwoCapsAndACurvedWall:\
 Flats.RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats:Flats.OrganicShapesHaveNoFlats:Flats.FlatsMakeTheBoxMoreAccurate:\
 Flats.FilletTangentToAFlatIsNotAJunction:Flats.CreaseRefitPinsFacesAlongALatticeAxis:Sharpen.RimPocketsLeaveTheCurvedCreasesInPlace:\

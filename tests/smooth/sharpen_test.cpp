@@ -419,6 +419,35 @@ TEST(Sharpen, ThinPlatesGetBothEdgesOfTheirRim) {
     }
 }
 
+TEST(Sharpen, CrossingThinPlatesKeepEveryGuarantee) {
+  // Two or three rotated plates 1-4 cells thick through one another: rims
+  // next to other plates' faces, walls one sample thick, T and X joints.
+  test::Rng rng(23);
+  size_t walls = 0;
+  for (int k = 0; k < 10; ++k) {
+    SCOPED_TRACE("plates " + std::to_string(k));
+    const int64_t n = 44;
+    BinaryVolume v = test::make_volume(n, n, n);
+    const int plates = 2 + int(rng.range(0, 1));
+    for (int p = 0; p < plates; ++p) {
+      const Mat3 R = parse_rotation("random:" + std::to_string(rng.range(1, 100000)));
+      const Vec3 c = Vec3::Constant(n / 2.0) + Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 8;
+      const Vec3 half(10 + 6 * rng.uniform(), 8 + 6 * rng.uniform(), 0.5 + 1.5 * rng.uniform());
+      for (int64_t z = 0; z < n; ++z)
+        for (int64_t y = 0; y < n; ++y)
+          for (int64_t x = 0; x < n; ++x) {
+            const Vec3 q = R * (Vec3(double(x), double(y), double(z)) - c);
+            if (std::abs(q.x()) <= half.x() && std::abs(q.y()) <= half.y() && std::abs(q.z()) <= half.z())
+              v.inside[v.lattice.linear(x, y, z)] = 1;
+          }
+    }
+    const Sharpened r = run(v);
+    expect_valid(r.after, v);
+    walls += r.stats.wall_vertices;
+  }
+  EXPECT_GT(walls, 0u);
+}
+
 TEST(Sharpen, FandiskGetsMoreAccurate) {
   VOXPRESS_REQUIRE_SHARED_DATA();
   const test::VoxelizedModel v = test::voxelized_shared_model("fandisk.off", 128, 1);
