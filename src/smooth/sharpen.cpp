@@ -510,24 +510,28 @@ struct Sharpener {
     Near none;
     none.fill(-1);
     std::vector<Near> near(n, none);
+    std::vector<uint32_t> fresh;
     for (uint32_t v = 0; v < n; ++v)
-      if (seg.region[v] < 0)
+      if (seg.region[v] < 0) {
+        fresh.push_back(v);
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
           if (seg.region[adj[k]] >= 0) add(near[v], seg.region[adj[k]]);
-    std::vector<Near> next;
+      }
+    std::vector<Near> next(fresh.size());
     for (int round = 0; round < int(std::ceil(o.wall_thickness)) + 1; ++round) {
-      next = near;
-      for (uint32_t v = 0; v < n; ++v)
-        if (seg.region[v] < 0)
-          for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-            if (seg.region[adj[k]] < 0)
-              for (int32_t f : near[adj[k]])
-                if (f >= 0) add(next[v], f);
-      near.swap(next);
+      for (size_t i = 0; i < fresh.size(); ++i) {
+        const uint32_t v = fresh[i];
+        next[i] = near[v];
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+          if (seg.region[adj[k]] < 0)
+            for (int32_t f : near[adj[k]])
+              if (f >= 0) add(next[i], f);
+      }
+      for (size_t i = 0; i < fresh.size(); ++i) near[fresh[i]] = next[i];
     }
     std::vector<std::array<int32_t, 2>> pair(n, {-1, -1});
     std::vector<uint32_t> cand;
-    for (uint32_t v = 0; v < n; ++v) {
+    for (uint32_t v : fresh) {
       const Near& a = near[v];
       for (size_t i = 0; i < kNear && a[i] >= 0 && pair[v][0] < 0; ++i)
         for (size_t j = i + 1; j < kNear && a[j] >= 0; ++j) {
