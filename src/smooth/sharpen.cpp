@@ -474,7 +474,11 @@ struct Sharpener {
   // over fresh vertices, from members of two flats A, B whose normals are at
   // least 170 degrees apart (a plate's faces; 150 also took fandisk's curved
   // faces between its two nearly opposite sides), and lying between their
-  // planes at most `wall_thickness` cells apart, is on such a wall. Its
+  // planes at most `wall_thickness` cells apart, is on such a wall; beyond
+  // 12 cells the samples resolve the wall's own surface, and its 2-ring
+  // plane must be within 10 degrees of perpendicular to the flats (on
+  // fandisk's curved faces it is not: without this test a bound of 24 took
+  // them, r->t 0.0732 -> 0.0762 at 128^3). Its
   // plane: the widest separator of the inside samples of the sticks of the
   // wall vertices within 2 rings (over wall vertices) from those sticks'
   // outside samples that lie between A's and B's planes (outside because of
@@ -493,7 +497,8 @@ struct Sharpener {
   void fit_walls() {
     if (!(o.wall_thickness > 0)) return;
     constexpr uint32_t kWallFitRings = 2;
-    const double opposite = std::cos(170 * kPi / 180);
+    constexpr double kResolvedWall = 12;  // cells
+    const double opposite = std::cos(170 * kPi / 180), kWallLean = std::sin(10 * kPi / 180);
     // The flats (up to kNear, smallest ids) that reach each fresh vertex over
     // fresh vertices within the thickness plus 2 rings: Jacobi rounds, so
     // the result does not depend on the visiting order. A plate's rim is
@@ -538,12 +543,16 @@ struct Sharpener {
           const Flat &fa = seg.flats[size_t(a[i])], &fb = seg.flats[size_t(a[j])];
           const double ha = height(a[i], x[v]) / fa.index_normal.norm(),
                        hb = height(a[j], x[v]) / fb.index_normal.norm();
-          if (fa.index_normal.normalized().dot(fb.index_normal.normalized()) <= opposite && ha < 0.5 && hb < 0.5 &&
-              -(ha + hb) <= o.wall_thickness) {
-            pair[v] = {a[i], a[j]};
-            cand.push_back(v);
-            break;
-          }
+          const Vec3 na = fa.index_normal.normalized();
+          if (!(na.dot(fb.index_normal.normalized()) <= opposite && ha < 0.5 && hb < 0.5 &&
+                -(ha + hb) <= o.wall_thickness))
+            continue;
+          Plane own;
+          if (-(ha + hb) > kResolvedWall && !(ring_plane(v, own) && std::abs(own.n.normalized().dot(na)) < kWallLean))
+            continue;
+          pair[v] = {a[i], a[j]};
+          cand.push_back(v);
+          break;
         }
     }
     std::vector<Plane> wall(cand.size());

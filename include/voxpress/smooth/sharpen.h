@@ -87,7 +87,7 @@ struct SharpenOptions {
   /// wall between two nearly opposite flats) gets its own plane, the widest
   /// separator of its sticks' samples, so both its edges are sharpened (0:
   /// off). See fit_walls in sharpen.cpp.
-  double wall_thickness = 12;
+  double wall_thickness = 24;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
