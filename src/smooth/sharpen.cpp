@@ -504,23 +504,27 @@ struct Sharpener {
     // the result does not depend on the visiting order. A plate's rim is
     // crossed in about as many rings as it has cells.
     constexpr size_t kNear = 4;
-    using Near = std::array<int32_t, kNear>;
-    auto add = [](Near& a, int32_t f) {
-      for (int32_t& g : a) {
-        if (g == f) return;
-        if (g < 0 || f < g) std::swap(g, f);
-        if (f < 0) return;
+    struct Reach {
+      int32_t flat = -1, ring = 0;  // a flat, and the ring at which it was first reached
+    };
+    using Near = std::array<Reach, kNear>;
+    auto add = [](Near& a, Reach r) {
+      for (Reach& g : a) {
+        if (g.flat == r.flat) {
+          g.ring = std::min(g.ring, r.ring);
+          return;
+        }
+        if (g.flat < 0 || r.flat < g.flat) std::swap(g, r);
+        if (r.flat < 0) return;
       }
     };
-    Near none;
-    none.fill(-1);
-    std::vector<Near> near(n, none);
+    std::vector<Near> near(n);
     std::vector<uint32_t> fresh;
     for (uint32_t v = 0; v < n; ++v)
       if (seg.region[v] < 0) {
         fresh.push_back(v);
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-          if (seg.region[adj[k]] >= 0) add(near[v], seg.region[adj[k]]);
+          if (seg.region[adj[k]] >= 0) add(near[v], {seg.region[adj[k]], 1});
       }
     std::vector<Near> next(fresh.size());
     for (int round = 0; round < int(std::ceil(o.wall_thickness)) + 1; ++round) {
@@ -529,8 +533,8 @@ struct Sharpener {
         next[i] = near[v];
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
           if (seg.region[adj[k]] < 0)
-            for (int32_t f : near[adj[k]])
-              if (f >= 0) add(next[i], f);
+            for (const Reach& r : near[adj[k]])
+              if (r.flat >= 0) add(next[i], {r.flat, r.ring + 1});
       }
       for (size_t i = 0; i < fresh.size(); ++i) near[fresh[i]] = next[i];
     }
@@ -538,19 +542,22 @@ struct Sharpener {
     std::vector<uint32_t> cand;
     for (uint32_t v : fresh) {
       const Near& a = near[v];
-      for (size_t i = 0; i < kNear && a[i] >= 0 && pair[v][0] < 0; ++i)
-        for (size_t j = i + 1; j < kNear && a[j] >= 0; ++j) {
-          const Flat &fa = seg.flats[size_t(a[i])], &fb = seg.flats[size_t(a[j])];
-          const double ha = height(a[i], x[v]) / fa.index_normal.norm(),
-                       hb = height(a[j], x[v]) / fb.index_normal.norm();
+      for (size_t i = 0; i < kNear && a[i].flat >= 0 && pair[v][0] < 0; ++i)
+        for (size_t j = i + 1; j < kNear && a[j].flat >= 0; ++j) {
+          const Flat &fa = seg.flats[size_t(a[i].flat)], &fb = seg.flats[size_t(a[j].flat)];
+          const double ha = height(a[i].flat, x[v]) / fa.index_normal.norm(),
+                       hb = height(a[j].flat, x[v]) / fb.index_normal.norm(), thickness = -(ha + hb);
           const Vec3 na = fa.index_normal.normalized();
+          // Between the two planes, and across the wall from both flats (a
+          // rim is crossed in about as many rings as it has cells, plus the
+          // rings the flats' rims stop short of the creases).
           if (!(na.dot(fb.index_normal.normalized()) <= opposite && ha < 0.5 && hb < 0.5 &&
-                -(ha + hb) <= o.wall_thickness))
+                thickness <= o.wall_thickness && std::max(a[i].ring, a[j].ring) <= 1.5 * thickness + 4))
             continue;
           Plane own;
-          if (-(ha + hb) > kResolvedWall && !(ring_plane(v, own) && std::abs(own.n.normalized().dot(na)) < kWallLean))
+          if (thickness > kResolvedWall && !(ring_plane(v, own) && std::abs(own.n.normalized().dot(na)) < kWallLean))
             continue;
-          pair[v] = {a[i], a[j]};
+          pair[v] = {a[i].flat, a[j].flat};
           cand.push_back(v);
           break;
         }
