@@ -500,12 +500,15 @@ struct Sharpener {
     constexpr double kResolvedWall = 12;  // cells
     const double opposite = std::cos(170 * kPi / 180), kWallLean = std::sin(10 * kPi / 180);
     // The flats (up to kNear, smallest ids) that reach each fresh vertex over
-    // fresh vertices within the thickness plus 2 rings: Jacobi rounds, so
-    // the result does not depend on the visiting order. A plate's rim is
-    // crossed in about as many rings as it has cells.
+    // fresh vertices within wall_thickness + 2 rings, each with the ring it
+    // first arrived at. Jacobi rounds, so the result does not depend on the
+    // visiting order; each round recomputes only the fresh neighbours of the
+    // vertices the last round changed (an organic shape's fresh vertices far
+    // from any flat are never visited).
     constexpr size_t kNear = 4;
     struct Reach {
-      int32_t flat = -1, ring = 0;  // a flat, and the ring at which it was first reached
+      int32_t flat = -1, ring = 0;
+      bool operator==(const Reach&) const = default;
     };
     using Near = std::array<Reach, kNear>;
     auto add = [](Near& a, Reach r) {
@@ -519,24 +522,42 @@ struct Sharpener {
       }
     };
     std::vector<Near> near(n);
-    std::vector<uint32_t> fresh;
+    std::vector<uint32_t> fresh, changed, todo;
     for (uint32_t v = 0; v < n; ++v)
       if (seg.region[v] < 0) {
         fresh.push_back(v);
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
           if (seg.region[adj[k]] >= 0) add(near[v], {seg.region[adj[k]], 1});
+        if (near[v][0].flat >= 0) changed.push_back(v);
       }
-    std::vector<Near> next(fresh.size());
-    for (int round = 0; round < int(std::ceil(o.wall_thickness)) + 1; ++round) {
-      for (size_t i = 0; i < fresh.size(); ++i) {
-        const uint32_t v = fresh[i];
+    std::vector<uint32_t> queued(n, detail::kUnreached);
+    std::vector<Near> next;
+    for (uint32_t round = 0; round < uint32_t(std::ceil(o.wall_thickness)) + 1 && !changed.empty(); ++round) {
+      todo.clear();
+      for (uint32_t v : changed)
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+          const uint32_t w = adj[k];
+          if (seg.region[w] < 0 && queued[w] != round) {
+            queued[w] = round;
+            todo.push_back(w);
+          }
+        }
+      std::sort(todo.begin(), todo.end());
+      next.resize(todo.size());
+      for (size_t i = 0; i < todo.size(); ++i) {
+        const uint32_t v = todo[i];
         next[i] = near[v];
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
           if (seg.region[adj[k]] < 0)
             for (const Reach& r : near[adj[k]])
               if (r.flat >= 0) add(next[i], {r.flat, r.ring + 1});
       }
-      for (size_t i = 0; i < fresh.size(); ++i) near[fresh[i]] = next[i];
+      changed.clear();
+      for (size_t i = 0; i < todo.size(); ++i)
+        if (next[i] != near[todo[i]]) {
+          near[todo[i]] = next[i];
+          changed.push_back(todo[i]);
+        }
     }
     std::vector<std::array<int32_t, 2>> pair(n, {-1, -1});
     std::vector<uint32_t> cand;
