@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <unordered_map>
 
@@ -110,6 +111,19 @@ struct Sharpener {
   // Signed distance (index space, outward positive) from flat f's plane to p.
   double height(int32_t f, const Vec3& p) const {
     return seg.flats[size_t(f)].index_normal.dot(p) - seg.flats[size_t(f)].index_offset;
+  }
+  // Where the plane normal . p = c crosses v's stick from its inside sample
+  // (t = 0) to its outside one (t = 1), unclamped; NaN when it is not
+  // crossed outwards.
+  double stick_crossing(uint32_t v, const Vec3& normal, double c) const {
+    const double hi = normal.dot(s.inside_sample(v)) - c, ho = normal.dot(s.outside_sample(v)) - c;
+    return ho > hi ? -hi / (ho - hi) : std::numeric_limits<double>::quiet_NaN();
+  }
+  // Puts v on its stick at t, kept in [margin, 1 - margin] (no sample
+  // changes side: Pressing's guarantee).
+  void slide(uint32_t v, double t) {
+    const Vec3 in = s.inside_sample(v);
+    x[v] = in + std::clamp(t, o.margin, 1 - o.margin) * (s.outside_sample(v) - in);
   }
   double angle_deg(const Vec3& na, const Vec3& nb) const { return degrees_between(physical_normal(na), physical_normal(nb)); }
 
@@ -386,7 +400,7 @@ struct Sharpener {
     });
     for (uint32_t v = 0; v < n; ++v) {
       if (flat[v] < 0) continue;
-      x[v] = s.inside_sample(v) + t[v] * (s.outside_sample(v) - s.inside_sample(v));
+      slide(v, t[v]);  // t is already in [margin, 1 - margin]
       label[v] = flat[v];
       ++st.snapped;
     }
@@ -442,14 +456,13 @@ struct Sharpener {
     std::vector<uint32_t> pocket;
     for (const auto& [v, f] : joins) {
       if (small[v] == kRimStrip) {
-        const Vec3 in = s.inside_sample(v), out = s.outside_sample(v);
-        const double hi = height(f, in), ho = height(f, out);
-        const double t = ho > hi ? -hi / (ho - hi) : -1;  // crossed outwards only
+        const Flat& F = seg.flats[size_t(f)];
+        const double t = stick_crossing(v, F.index_normal, F.index_offset);  // NaN unless crossed outwards
         if (!(t > -0.1 && t < 1.1)) {
           pocket.push_back(v);
           continue;
         }
-        x[v] = in + std::clamp(t, o.margin, 1 - o.margin) * (out - in);
+        slide(v, t);
       }
       label[v] = f;
       if (small[v] == kLeftover) leftovers.push_back(v);  // a thin strip's vertices keep their place
@@ -583,6 +596,9 @@ struct Sharpener {
           break;
         }
     }
+    // An outside sample between A's and B's planes is outside because of the
+    // wall, not of a flat.
+    auto between = [&](int32_t A, int32_t B, const Vec3& p) { return height(A, p) < 0 && height(B, p) < 0; };
     std::vector<Plane> wall(cand.size());
     std::vector<uint8_t> ok(cand.size(), 0);
     tbb::enumerable_thread_specific<detail::RingScratch> scratch;
@@ -609,7 +625,7 @@ struct Sharpener {
         for (const auto& [q, d] : rs.out) {
           const Vec3 pi = s.inside_sample(q), po = s.outside_sample(q);
           in.emplace_back(u.dot(pi), w.dot(pi));
-          if (height(A, po) < 0 && height(B, po) < 0) out.emplace_back(u.dot(po), w.dot(po));
+          if (between(A, B, po)) out.emplace_back(u.dot(po), w.dot(po));
         }
         if (in.size() < 3 || out.size() < 3) continue;
         double best = -INFINITY, best_a = 0;
@@ -633,11 +649,10 @@ struct Sharpener {
     for (size_t k = 0; k < cand.size(); ++k) {
       const uint32_t v = cand[k];
       const auto [A, B] = pair[v];
-      const Vec3 pi = s.inside_sample(v), po = s.outside_sample(v);
-      if (!ok[k] || !(height(A, po) < 0 && height(B, po) < 0)) continue;  // no fit, or a flat's stick
-      const double hi = wall[k].n.dot(pi) - wall[k].c, ho = wall[k].n.dot(po) - wall[k].c;
-      if (!(ho > hi)) continue;
-      x[v] = pi + std::clamp(-hi / (ho - hi), o.margin, 1 - o.margin) * (po - pi);
+      if (!ok[k] || !between(A, B, s.outside_sample(v))) continue;  // no fit, or a flat's stick
+      const double t = stick_crossing(v, wall[k].n, wall[k].c);
+      if (std::isnan(t)) continue;
+      slide(v, t);
       label[v] = -1;
       junction[v] = 1;
       plane[v] = wall[k];
