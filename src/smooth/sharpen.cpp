@@ -506,11 +506,16 @@ struct Sharpener {
   // the wall's, so the chamfers on both sides cut along wall ∩ A and wall ∩
   // B. Fixed 2- or 3-ring fits were measured worse than 1 ring (their
   // infeasible fits left vertices out); 3 rings first, then 2 and 1, is no
-  // better than 2 then 1 (docs/ARCHITECTURE.md).
+  // better than 2 then 1 (docs/ARCHITECTURE.md). Rim vertices on a flat's
+  // stick (its outside sample above a face) that joined a flat, and the
+  // flats' own vertices next to the wall, go where their stick first leaves
+  // the solid, through the wall or the flat; left on a flat mid-rim, they
+  // kinked it.
   void fit_walls() {
     if (!(o.wall_thickness > 0)) return;
     constexpr uint32_t kWallFitRings = 2;
     constexpr double kResolvedWall = 12;  // cells
+    constexpr double kFlatGap = 0.1;      // cells: a fitted flat's plane may be this far off near its rim
     const double opposite = std::cos(170 * kPi / 180), kWallLean = std::sin(10 * kPi / 180);
     // The flats (up to kNear, smallest ids) that reach each fresh vertex over
     // fresh vertices within wall_thickness + 2 rings, each with the ring it
@@ -596,9 +601,12 @@ struct Sharpener {
           break;
         }
     }
-    // An outside sample between A's and B's planes is outside because of the
-    // wall, not of a flat.
-    auto between = [&](int32_t A, int32_t B, const Vec3& p) { return height(A, p) < 0 && height(B, p) < 0; };
+    // An outside sample between A's and B's planes (by more than `gap`
+    // cells) is outside because of the wall, not of a flat.
+    auto between = [&](int32_t A, int32_t B, const Vec3& p, double gap = 0) {
+      return height(A, p) < -gap * seg.flats[size_t(A)].index_normal.norm() &&
+             height(B, p) < -gap * seg.flats[size_t(B)].index_normal.norm();
+    };
     std::vector<Plane> wall(cand.size());
     std::vector<uint8_t> ok(cand.size(), 0);
     tbb::enumerable_thread_specific<detail::RingScratch> scratch;
@@ -618,14 +626,19 @@ struct Sharpener {
         return hi - lo;
       };
       detail::RingScratch& rs = scratch.local();
-      for (uint32_t rings_fit = kWallFitRings; rings_fit >= 1; --rings_fit) {
+      // (rings, gap) tried in turn; the gap only for a vertex that joined a
+      // flat (a strip or leftover vertex mid-rim: otherwise a kink).
+      constexpr std::pair<uint32_t, double> kAttempts[] = {
+          {kWallFitRings, 0.0}, {1, 0.0}, {kWallFitRings, kFlatGap}, {1, kFlatGap}};
+      for (const auto& [rings_fit, gap] : kAttempts) {
+        if (gap > 0 && label[v] < 0) break;
         in.clear();
         out.clear();
         detail::rings_around(v, rings_fit, adj_off, adj, [&](uint32_t q) { return pair[q] == pair[v]; }, rs);
         for (const auto& [q, d] : rs.out) {
           const Vec3 pi = s.inside_sample(q), po = s.outside_sample(q);
           in.emplace_back(u.dot(pi), w.dot(pi));
-          if (between(A, B, po)) out.emplace_back(u.dot(po), w.dot(po));
+          if (between(A, B, po, gap)) out.emplace_back(u.dot(po), w.dot(po));
         }
         if (in.size() < 3 || out.size() < 3) continue;
         double best = -INFINITY, best_a = 0;
@@ -645,22 +658,71 @@ struct Sharpener {
         return;
       }
     });
-    std::vector<uint8_t> is_wall(n, 0);
-    for (size_t k = 0; k < cand.size(); ++k) {
-      const uint32_t v = cand[k];
-      const auto [A, B] = pair[v];
-      if (!ok[k] || !between(A, B, s.outside_sample(v))) continue;  // no fit, or a flat's stick
-      const double t = stick_crossing(v, wall[k].n, wall[k].c);
-      if (std::isnan(t)) continue;
+    enum : uint8_t { kUnplaced, kOnFlat, kOnWall };
+    std::vector<uint8_t> placed(n, kUnplaced);
+    auto make_wall = [&](uint32_t v, double t, const Plane& p) {
       slide(v, t);
       label[v] = -1;
       junction[v] = 1;
-      plane[v] = wall[k];
+      plane[v] = p;
       plane_state[v] = 1;
-      is_wall[v] = 1;
+      placed[v] = kOnWall;
       ++st.wall_vertices;
+    };
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const uint32_t v = cand[k];
+      const auto [A, B] = pair[v];
+      if (!ok[k]) continue;
+      const double t = stick_crossing(v, wall[k].n, wall[k].c);  // NaN unless crossed outwards
+      if (between(A, B, s.outside_sample(v))) {
+        if (!std::isnan(t)) make_wall(v, t, wall[k]);
+        continue;
+      }
+      // A flat's stick. A vertex that joined a flat mid-rim (a strip or
+      // leftover; left there, the rim kinks) goes where its stick first
+      // leaves the solid: through the wall's plane or a flat's. Other
+      // curved vertices stay: at a rounded edge neither plane bounds the
+      // solid (plate_holes.STL at 256^3: moved onto a flat's plane, 0.8
+      // voxel out).
+      if (label[v] < 0) continue;
+      int32_t first = -1;
+      double tf = std::isnan(t) ? INFINITY : t;
+      for (const int32_t f : {A, B}) {
+        const Flat& F = seg.flats[size_t(f)];
+        const double tc = stick_crossing(v, F.index_normal, F.index_offset);
+        if (tc > -0.1 && tc < tf) tf = tc, first = f;
+      }
+      if (first < 0) {
+        if (!std::isnan(t)) make_wall(v, t, wall[k]);
+      } else if (tf < 1.1) {
+        slide(v, tf);
+        label[v] = first;
+        placed[v] = kOnFlat;
+      }
     }
-    std::erase_if(leftovers, [&](uint32_t v) { return is_wall[v] != 0; });
+    // A flat's vertex (frozen or joined) next to a wall vertex of that flat
+    // whose stick crosses the wall's plane before its flat's: the surface
+    // leaves the solid through the wall, and the flat's plane there lies
+    // beyond the rim (up to 0.6 voxel out on examples/plate.obj at 64^3).
+    // Decided from the walls above only, so the order does not matter.
+    std::vector<std::pair<uint32_t, uint32_t>> to_wall;  // (v, the wall vertex whose plane it takes)
+    for (uint32_t v = 0; v < n; ++v) {
+      const int32_t f = label[v];
+      if (f < 0 || placed[v] != kUnplaced) continue;
+      const Flat& F = seg.flats[size_t(f)];
+      double first = stick_crossing(v, F.index_normal, F.index_offset);
+      if (std::isnan(first)) continue;
+      uint32_t by = kNone;
+      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+        const uint32_t w = adj[k];
+        if (placed[w] != kOnWall || (pair[w][0] != f && pair[w][1] != f)) continue;
+        const double tw = stick_crossing(v, plane[w].n, plane[w].c);
+        if (tw > -0.1 && tw < first) first = tw, by = w;
+      }
+      if (by != kNone) to_wall.push_back({v, by});
+    }
+    for (const auto& [v, w] : to_wall) make_wall(v, stick_crossing(v, plane[w].n, plane[w].c), plane[w]);
+    std::erase_if(leftovers, [&](uint32_t v) { return placed[v] != kUnplaced; });
   }
 
   uint32_t add_vertex(const NewVertex& v, const Vec3& at) {

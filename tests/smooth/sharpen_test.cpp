@@ -402,12 +402,15 @@ TEST(Sharpen, ThinPlatesGetBothEdgesOfTheirRim) {
       EXPECT_GT(with.stats.wall_vertices, 0u);
       EXPECT_EQ(without.stats.wall_vertices, 0u);
       const EvalReport a = eval(with.after, *v.truth, v.volume), b = eval(without.after, *v.truth, v.volume);
-      // Measured (with / without): recall 0.94-0.96 / 0.00-0.09, precision
-      // 0.91-0.97 / 0.00-0.15, result -> truth 0.028-0.040 / 0.086-0.095.
+      // Measured (with / without): recall 0.95-0.97 / 0.00-0.09, precision
+      // 0.975-0.994 / 0.00-0.15, result -> truth 0.024-0.035 / 0.086-0.095.
+      // Before the rim's flat vertices took the wall's plane where their
+      // stick crosses it first, precision was 0.91-0.97 and result -> truth
+      // 0.028-0.040: the rim kinked where a flat's plane ran past it.
       EXPECT_GT(a.sharp_recall.value_or(0), 0.85);
-      EXPECT_GT(a.sharp_precision.value_or(0), 0.85);
+      EXPECT_GT(a.sharp_precision.value_or(0), 0.95);
       EXPECT_LT(b.sharp_recall.value_or(0), 0.3);
-      EXPECT_LT(a.result_to_truth_vox.rms, 0.7 * b.result_to_truth_vox.rms);
+      EXPECT_LT(a.result_to_truth_vox.rms, 0.45 * b.result_to_truth_vox.rms);
       if (seed == 1) {  // the walls are fitted in parallel: same result on one thread
         Sharpened one;
         tbb::task_arena arena(1);
