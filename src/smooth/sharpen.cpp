@@ -119,6 +119,13 @@ struct Sharpener {
     const double hi = normal.dot(s.inside_sample(v)) - c, ho = normal.dot(s.outside_sample(v)) - c;
     return ho > hi ? -hi / (ho - hi) : std::numeric_limits<double>::quiet_NaN();
   }
+  double flat_crossing(uint32_t v, int32_t f) const {
+    return stick_crossing(v, seg.flats[size_t(f)].index_normal, seg.flats[size_t(f)].index_offset);
+  }
+  // A crossing this far beyond either sample still counts as on the stick (a
+  // plane through a sample corner); slide() clamps it.
+  static bool on_stick(double t) { return t > -kPastSample && t < 1 + kPastSample; }
+  static constexpr double kPastSample = 0.1;
   // Puts v on its stick at t, kept in [margin, 1 - margin] (no sample
   // changes side: Pressing's guarantee).
   void slide(uint32_t v, double t) {
@@ -456,9 +463,8 @@ struct Sharpener {
     std::vector<uint32_t> pocket;
     for (const auto& [v, f] : joins) {
       if (small[v] == kRimStrip) {
-        const Flat& F = seg.flats[size_t(f)];
-        const double t = stick_crossing(v, F.index_normal, F.index_offset);  // NaN unless crossed outwards
-        if (!(t > -0.1 && t < 1.1)) {
+        const double t = flat_crossing(v, f);  // NaN unless crossed outwards
+        if (!on_stick(t)) {
           pocket.push_back(v);
           continue;
         }
@@ -688,13 +694,12 @@ struct Sharpener {
       int32_t first = -1;
       double tf = std::isnan(t) ? INFINITY : t;
       for (const int32_t f : {A, B}) {
-        const Flat& F = seg.flats[size_t(f)];
-        const double tc = stick_crossing(v, F.index_normal, F.index_offset);
-        if (tc > -0.1 && tc < tf) tf = tc, first = f;
+        const double tc = flat_crossing(v, f);
+        if (tc > -kPastSample && tc < tf) tf = tc, first = f;
       }
       if (first < 0) {
         if (!std::isnan(t)) make_wall(v, t, wall[k]);
-      } else if (tf < 1.1) {
+      } else if (on_stick(tf)) {
         slide(v, tf);
         label[v] = first;
         placed[v] = kOnFlat;
@@ -705,23 +710,26 @@ struct Sharpener {
     // leaves the solid through the wall, and the flat's plane there lies
     // beyond the rim (up to 0.6 voxel out on examples/plate.obj at 64^3).
     // Decided from the walls above only, so the order does not matter.
-    std::vector<std::pair<uint32_t, uint32_t>> to_wall;  // (v, the wall vertex whose plane it takes)
+    struct ToWall {
+      uint32_t v, by;  // by: the wall vertex whose plane v takes
+      double t;
+    };
+    std::vector<ToWall> to_wall;
     for (uint32_t v = 0; v < n; ++v) {
       const int32_t f = label[v];
       if (f < 0 || placed[v] != kUnplaced) continue;
-      const Flat& F = seg.flats[size_t(f)];
-      double first = stick_crossing(v, F.index_normal, F.index_offset);
-      if (std::isnan(first)) continue;
+      double t_first = flat_crossing(v, f);
+      if (std::isnan(t_first)) continue;
       uint32_t by = kNone;
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
         const uint32_t w = adj[k];
         if (placed[w] != kOnWall || (pair[w][0] != f && pair[w][1] != f)) continue;
         const double tw = stick_crossing(v, plane[w].n, plane[w].c);
-        if (tw > -0.1 && tw < first) first = tw, by = w;
+        if (tw > -kPastSample && tw < t_first) t_first = tw, by = w;
       }
-      if (by != kNone) to_wall.push_back({v, by});
+      if (by != kNone) to_wall.push_back({v, by, t_first});
     }
-    for (const auto& [v, w] : to_wall) make_wall(v, stick_crossing(v, plane[w].n, plane[w].c), plane[w]);
+    for (const ToWall& m : to_wall) make_wall(m.v, m.t, plane[m.by]);
     std::erase_if(leftovers, [&](uint32_t v) { return placed[v] != kUnplaced; });
   }
 
