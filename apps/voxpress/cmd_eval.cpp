@@ -13,6 +13,7 @@ struct EvalCmd {
   InputOptions in;
   size_t samples = 400000;
   uint64_t seed = 1;
+  double sharp_match = 0.5;
   bool no_self_intersections = false;
 };
 
@@ -33,6 +34,7 @@ void run_eval(const EvalCmd& c, const Global& g) {
   EvalOptions o;
   o.samples = c.samples;
   o.seed = c.seed;
+  o.sharp_match_vox = c.sharp_match;
   o.volume = vol ? &*vol : nullptr;
   o.self_intersections = !c.no_self_intersections;
   ProgressBar bar(!g.quiet);
@@ -144,6 +146,10 @@ void register_eval(CLI::App& app, Global& g) {
   cmd->add_option("--json", c->json, "Also write the report as JSON");
   cmd->add_option("--samples", c->samples, "Area samples per direction")->capture_default_str();
   cmd->add_option("--seed", c->seed, "Sampling seed")->capture_default_str();
+  cmd->add_option("--sharp-match", c->sharp_match,
+                  "Voxels: a sharp curve point this close to the other set counts as found (recall, precision)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--no-self-intersections", c->no_self_intersections, "Skip the self-intersection test");
   cmd->callback([c, &g] {
     g.apply();

@@ -56,6 +56,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"fallbacks", st.fallbacks},
           {"tangent_planes", st.tangent_planes},
           {"wall_vertices", st.wall_vertices},
+          {"final_crease_vertices", st.final_crease_vertices},
           {"snapped", st.snapped},
           {"cut_back", st.cut_back},
           {"sharp_edges", st.sharp_edges},
@@ -220,6 +221,11 @@ void register_press(CLI::App& app, Global& g) {
                  "both its edges are sharpened (0: off)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 64.0));
+  sh->add_option("--final-crease-rings", c->sharpen.final_crease_rings,
+                 "Curved vertices up to this many rings from a sharp flat border are placed again by the curved "
+                 "side's quadric fit once the regions are final (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 8));
   sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "crease_fit.h"
 #include "quadric.h"
 #include "surface_graph.h"
 #include "voxpress/smooth/flats.h"
@@ -20,6 +21,75 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
+
+namespace detail {
+
+std::vector<std::pair<uint32_t, double>> crease_targets(const std::vector<Flat>& flats,
+                                                        const std::vector<int32_t>& region,
+                                                        const std::vector<uint8_t>& junction,
+                                                        const std::vector<Vec3>& x, const std::vector<Vec3>& in,
+                                                        const std::vector<Vec3>& out, const std::vector<uint32_t>& off,
+                                                        const std::vector<uint32_t>& adj, const CreaseFit& c) {
+  const size_t n = region.size();
+  // Ring distance of each curved vertex from the junctions (over curved
+  // vertices) up to R, beyond that kUnreached, and the flat of the junction
+  // it was reached from.
+  std::vector<uint32_t> dist(n, kUnreached);
+  std::vector<int32_t> flat(n, -1);
+  std::vector<uint32_t> front;
+  for (size_t v = 0; v < n; ++v) {
+    if (region[v] >= 0 || !junction[v]) continue;
+    for (uint32_t k = off[v]; k < off[v + 1] && flat[v] < 0; ++k) flat[v] = region[adj[k]];
+    if (flat[v] < 0) continue;
+    dist[v] = 0;
+    front.push_back(uint32_t(v));
+  }
+  const uint32_t R = uint32_t(c.rings), F = uint32_t(c.fit_rings);
+  spread_rings(std::move(front), 0, R, off, adj, dist, [&](uint32_t v, uint32_t w) {
+    if (region[w] >= 0) return false;
+    flat[w] = flat[v];
+    return true;
+  });
+  std::vector<uint32_t> members;
+  for (size_t v = 0; v < n; ++v)
+    if (dist[v] <= R) members.push_back(uint32_t(v));
+  std::vector<double> t_new(members.size(), std::numeric_limits<double>::quiet_NaN());
+  tbb::enumerable_thread_specific<RingScratch> scratch;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    RingScratch& rs = scratch.local();
+    std::vector<Vec3> pts;
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const uint32_t v = members[i];
+      // Anchors: curved vertices beyond the zone, within R + F rings of v.
+      rings_around(v, R + F, off, adj, [&](uint32_t w) { return region[w] < 0; }, rs);
+      pts.clear();
+      Vec3 outward = Vec3::Zero();
+      for (const auto& [w, d] : rs.out)
+        if (dist[w] > R) {
+          pts.push_back(x[w]);
+          outward += out[w] - in[w];
+        }
+      Quadric Q;
+      if (!Q.fit(pts, outward) || Q.residual > c.residual) continue;
+      const double tv = (x[v] - in[v]).dot(out[v] - in[v]);
+      const double tc = Q.exit(in[v], out[v], tv, -1, 2);
+      if (std::isnan(tc)) continue;
+      // The flat's plane (index space) and the rule between the two sides.
+      const Flat& f = flats[size_t(flat[v])];
+      const double fi = f.index_normal.dot(in[v]) - f.index_offset, fo = f.index_normal.dot(out[v]) - f.index_offset;
+      const double tf = fi >= 0 ? -kInf : fo <= 0 ? kInf : -fi / (fo - fi);
+      const bool convex = f.index_normal.dot(Q.m) < f.index_offset;
+      const double t = std::clamp(convex ? std::min(tc, tf) : std::max(tc, tf), c.margin, 1 - c.margin);
+      if (std::abs(t - tv) <= c.max_move) t_new[i] = t;
+    }
+  });
+  std::vector<std::pair<uint32_t, double>> targets;
+  for (size_t i = 0; i < members.size(); ++i)
+    if (!std::isnan(t_new[i])) targets.push_back({members[i], t_new[i]});
+  return targets;
+}
+
+}  // namespace detail
 
 size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o, std::vector<uint8_t>* zone) {
   const size_t n = s.stick_count();
@@ -33,67 +103,13 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
     in[v] = s.inside_sample(v);
     out[v] = s.outside_sample(v);
   });
-  // Ring distance of each fresh vertex from the junctions (over fresh
-  // vertices) up to R, beyond that kUnreached, and the flat of the junction it
-  // was reached from.
-  std::vector<uint32_t> dist(n, detail::kUnreached);
-  std::vector<int32_t> flat(n, -1);
-  std::vector<uint32_t> front;
-  for (size_t v = 0; v < n; ++v) {
-    if (seg.region[v] >= 0 || !seg.junction[v]) continue;
-    for (uint32_t k = off[v]; k < off[v + 1] && flat[v] < 0; ++k) flat[v] = seg.region[adj[k]];
-    if (flat[v] < 0) continue;
-    dist[v] = 0;
-    front.push_back(uint32_t(v));
-  }
-  const uint32_t R = uint32_t(o.crease_rings), F = uint32_t(o.crease_fit_rings);
-  detail::spread_rings(std::move(front), 0, R, off, adj, dist, [&](uint32_t v, uint32_t w) {
-    if (seg.region[w] >= 0) return false;
-    flat[w] = flat[v];
-    return true;
-  });
-  std::vector<uint32_t> members;
-  for (size_t v = 0; v < n; ++v)
-    if (dist[v] <= R) members.push_back(uint32_t(v));
-  std::vector<double> t_new(members.size(), std::numeric_limits<double>::quiet_NaN());
-  tbb::enumerable_thread_specific<detail::RingScratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-    detail::RingScratch& rs = scratch.local();
-    std::vector<Vec3> pts;
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      const uint32_t v = members[i];
-      // Anchors: fresh vertices beyond the zone, within R + F rings of v.
-      detail::rings_around(v, R + F, off, adj, [&](uint32_t w) { return seg.region[w] < 0; }, rs);
-      pts.clear();
-      Vec3 outward = Vec3::Zero();
-      for (const auto& [w, d] : rs.out)
-        if (dist[w] > R) {
-          pts.push_back(x[w]);
-          outward += out[w] - in[w];
-        }
-      detail::Quadric Q;
-      if (!Q.fit(pts, outward) || Q.residual > o.crease_residual) continue;
-      const double tv = (x[v] - in[v]).dot(out[v] - in[v]);
-      const double tc = Q.exit(in[v], out[v], tv, -1, 2);
-      if (std::isnan(tc)) continue;
-      // The flat's plane (index space) and the rule between the two sides.
-      const Flat& f = seg.flats[size_t(flat[v])];
-      const double fi = f.index_normal.dot(in[v]) - f.index_offset, fo = f.index_normal.dot(out[v]) - f.index_offset;
-      const double tf = fi >= 0 ? -kInf : fo <= 0 ? kInf : -fi / (fo - fi);
-      const bool convex = f.index_normal.dot(Q.m) < f.index_offset;
-      const double t = convex ? std::min(tc, tf) : std::max(tc, tf);
-      t_new[i] = std::clamp(t, o.margin, 1 - o.margin);
-    }
-  });
-  size_t moved = 0;
-  for (size_t i = 0; i < members.size(); ++i) {
-    if (std::isnan(t_new[i])) continue;
-    const uint32_t v = members[i];
-    s.t[v] = s.lower_inside(v) ? t_new[i] : 1 - t_new[i];
+  const detail::CreaseFit c{o.crease_rings, o.crease_fit_rings, o.crease_residual, o.margin, 1};
+  const auto targets = detail::crease_targets(seg.flats, seg.region, seg.junction, x, in, out, off, adj, c);
+  for (const auto& [v, t] : targets) {
+    s.t[v] = s.lower_inside(v) ? t : 1 - t;
     if (zone) (*zone)[v] = 1;
-    ++moved;
   }
-  return moved;
+  return targets.size();
 }
 
 }  // namespace voxpress

@@ -427,6 +427,7 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   EXPECT_TRUE(st.contains("sharpen"));
   EXPECT_GT(st["sharpen"]["sharp_edges"].get<size_t>(), 0u);
   EXPECT_EQ(st["sharpen"]["tangent_planes"].get<size_t>(), 0u);  // a box: no curved side
+  EXPECT_EQ(st["sharpen"]["final_crease_vertices"].get<size_t>(), 0u);
   ASSERT_TRUE(m.face_attribute("region") != nullptr);
   ASSERT_TRUE(m.vertex_attribute("feature") != nullptr);
   EXPECT_EQ(m.edges.size(), st["sharpen"]["sharp_edges"].get<size_t>());
@@ -441,6 +442,16 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   const auto ev = nlohmann::json::parse(std::ifstream(tmp.path("e.json")));
   EXPECT_LT(ev["sharp_edges"]["voxels"]["hausdorff"].get<double>(), 3.0);
   EXPECT_EQ(ev["labelled_sharp_edges"].get<size_t>(), m.edges.size());
+  // --sharp-match: the distance that counts as found, recorded in the report.
+  ASSERT_EQ(run_cli("-q eval " + tmp.path("b.ply") + " --volume " + tmp.path("b.nrrd") + " --sharp-match 0.0001 --json " +
+                        tmp.path("e2.json"),
+                    &out),
+            0)
+      << out;
+  const auto ev2 = nlohmann::json::parse(std::ifstream(tmp.path("e2.json")));
+  EXPECT_DOUBLE_EQ(ev2["sharp_edges"]["voxels"]["match"].get<double>(), 0.0001);
+  EXPECT_LT(ev2["sharp_edges"]["voxels"]["recall"].get<double>(), ev["sharp_edges"]["voxels"]["recall"].get<double>());
+  EXPECT_EQ(run_cli("-q eval " + tmp.path("b.ply") + " --volume " + tmp.path("b.nrrd") + " --sharp-match -1", &out), 2);
   // --no-sharpen: the chamfered surface, vertex regions only; --features then is a usage error.
   ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("c.ply") + " --no-sharpen", &out), 0) << out;
   const Mesh chamfered = read_mesh(tmp.path("c.ply"));

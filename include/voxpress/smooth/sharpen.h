@@ -12,6 +12,8 @@
 //     (`snap_rings`, `snap_tolerance`, `snap_share`; a patch at least half
 //     explained retries the rest with twice the rings, for a corner's third
 //     flat); a curved face's sticks lie outside that solid and stay.
+//     Beyond the paper, the curved vertices next to the final junctions are
+//     placed again by the crease fit (`final_crease_rings`).
 //  1. Chamfer edges join vertices of two different regions (two flats, or a
 //     flat and a curved junction vertex); smooth flat/curved borders (no
 //     junction) and flats meeting at less than `min_angle` are left alone.
@@ -88,6 +90,17 @@ struct SharpenOptions {
   /// separator of its sticks' samples, so both its edges are sharpened (0:
   /// off). See fit_walls in sharpen.cpp.
   double wall_thickness = 24;
+  /// Beyond the paper: once the labels are final, the curved vertices up to
+  /// this many rings from a junction are placed again by the crease fit of
+  /// press_with_flats (the flat's plane and the curved side's quadric over
+  /// the next `final_crease_fit_rings` rings, trusted up to
+  /// `final_crease_residual` cells RMS), each moving at most
+  /// `final_crease_max_move` cells along its stick (0: off). See
+  /// final_crease_fit in sharpen.cpp.
+  int final_crease_rings = 2;
+  int final_crease_fit_rings = 5;
+  double final_crease_residual = 0.04;
+  double final_crease_max_move = 0.3;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -100,6 +113,7 @@ struct SharpenStats {
   size_t snapped = 0;                 ///< original vertices slid along their sticks onto a flat (snap_to_flats)
   size_t tangent_planes = 0;          ///< curved sides whose plane is their quadric's tangent plane
   size_t wall_vertices = 0;           ///< vertices given a thin wall's plane (fit_walls)
+  size_t final_crease_vertices = 0;   ///< curved vertices placed again by the crease fit (final_crease_fit)
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
