@@ -400,7 +400,7 @@ TEST(Flats, CreaseFitMakesTheCylinderRimMoreAccurate) {
     eo.samples = 20000;
     const double e_off = *evaluate(to_mesh(off), *truth, eo).stick_rms_vox;
     const double e_on = *evaluate(to_mesh(on), *truth, eo).stick_rms_vox;
-    EXPECT_LT(e_on, 0.85 * e_off) << "measured 0.109 -> 0.081 (seed 1), 0.126 -> 0.091 (seed 2)";
+    EXPECT_LT(e_on, 0.85 * e_off) << "measured 0.106 -> 0.072 (seed 1), 0.122 -> 0.078 (seed 2)";
   }
   // Without flats there is no junction and nothing to fit.
   GenerateOptions go;

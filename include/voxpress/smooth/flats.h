@@ -131,7 +131,7 @@ struct FlatOptions {
   int crease_rings = 3;
   int crease_fit_rings = 5;
   double crease_residual = 0.04;
-  int crease_rounds = 2;
+  int crease_rounds = 4;
   Progress* progress = nullptr;
 };
 
