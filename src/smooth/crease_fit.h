@@ -1,4 +1,4 @@
-// Private helper of fit_creases (press time) and of sharpen's crease refit:
+// Private helper of fit_creases (press time) and of sharpen's final crease fit:
 // where the sticks near a sharp flat/curved border leave the piecewise solid
 // of the flat's half-space and the curved side's quadric (index space).
 #pragma once
