@@ -237,15 +237,15 @@ TEST(Sharpen, FinalCreaseFitPlacesTheRoundedCreases) {
   // a rim had stopped short of a crease, the curved side stayed pressed in
   // 0.3-0.4 cell. Fitting again once the labels are final puts more of the
   // true flat/curved creases within 0.15 voxel of a label (measured,
-  // cylinder 128 seed 2: 0.873 -> 0.898; CAD part 128 seeds 2 / 7: 0.871 /
-  // 0.816 -> 0.927 / 0.908), and the result closer to the truth.
+  // cylinder 128 seeds 1 / 4: 0.967 / 0.977 -> 0.996 / 0.999; CAD part 128
+  // seed 4: 0.905 -> 0.928), and the result closer to the truth.
   SharpenOptions off;
   off.final_crease_rings = 0;
   struct Case {
     ShapeKind kind;
     int seed;
   };
-  for (const Case c : {Case{ShapeKind::cylinder, 2}, Case{ShapeKind::cad_part, 2}, Case{ShapeKind::cad_part, 7}}) {
+  for (const Case c : {Case{ShapeKind::cylinder, 1}, Case{ShapeKind::cylinder, 4}, Case{ShapeKind::cad_part, 4}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
     const GeneratedShape g = shape(c.kind, 128, c.seed);
     const auto truth = shape_truth(c.kind, g.linear, g.translation);

@@ -128,7 +128,7 @@ struct FlatOptions {
   /// rings from a junction are placed by a quadric fitted to the fresh
   /// vertices of the next `crease_fit_rings` rings, when its RMS residual is
   /// at most `crease_residual` cells; `crease_rounds` times (0: off).
-  int crease_rings = 3;
+  int crease_rings = 2;
   int crease_fit_rings = 5;
   double crease_residual = 0.04;
   int crease_rounds = 4;
