@@ -24,11 +24,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 namespace detail {
 
-std::vector<std::pair<uint32_t, double>> crease_targets(const std::vector<Flat>& flats,
+std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& sticks, const std::vector<Flat>& flats,
                                                         const std::vector<int32_t>& region,
                                                         const std::vector<uint8_t>& junction,
-                                                        const std::vector<Vec3>& x, const std::vector<Vec3>& in,
-                                                        const std::vector<Vec3>& out, const std::vector<uint32_t>& off,
+                                                        const std::vector<Vec3>& x, const std::vector<uint32_t>& off,
                                                         const std::vector<uint32_t>& adj, const CreaseFit& c) {
   const size_t n = region.size();
   // Ring distance of each curved vertex from the junctions (over curved
@@ -67,16 +66,17 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const std::vector<Flat>&
       for (const auto& [w, d] : rs.out)
         if (dist[w] > R) {
           pts.push_back(x[w]);
-          outward += out[w] - in[w];
+          outward += sticks.outside_sample(w) - sticks.inside_sample(w);
         }
       Quadric Q;
       if (!Q.fit(pts, outward) || Q.residual > c.residual) continue;
-      const double tv = (x[v] - in[v]).dot(out[v] - in[v]);
-      const double tc = Q.exit(in[v], out[v], tv, -1, 2);
+      const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
+      const double tv = (x[v] - in).dot(out - in);
+      const double tc = Q.exit(in, out, tv, -1, 2);
       if (std::isnan(tc)) continue;
       // The flat's plane (index space) and the rule between the two sides.
       const Flat& f = flats[size_t(flat[v])];
-      const double fi = f.index_normal.dot(in[v]) - f.index_offset, fo = f.index_normal.dot(out[v]) - f.index_offset;
+      const double fi = f.index_normal.dot(in) - f.index_offset, fo = f.index_normal.dot(out) - f.index_offset;
       const double tf = fi >= 0 ? -kInf : fo <= 0 ? kInf : -fi / (fo - fi);
       const bool convex = f.index_normal.dot(Q.m) < f.index_offset;
       const double t = std::clamp(convex ? std::min(tc, tf) : std::max(tc, tf), c.margin, 1 - c.margin);
@@ -97,14 +97,11 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
   if (seg.flats.empty() || o.crease_rings < 0) return 0;
   std::vector<uint32_t> off, adj;
   detail::vertex_adjacency(n, s.triangles, off, adj);
-  std::vector<Vec3> x(n), in(n), out(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
-    x[v] = s.index_position(v);
-    in[v] = s.inside_sample(v);
-    out[v] = s.outside_sample(v);
-  });
-  const detail::CreaseFit c{o.crease_rings, o.crease_fit_rings, o.crease_residual, o.margin, 1};
-  const auto targets = detail::crease_targets(seg.flats, seg.region, seg.junction, x, in, out, off, adj, c);
+  std::vector<Vec3> x(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
+  const detail::CreaseFit c{
+      .rings = o.crease_rings, .fit_rings = o.crease_fit_rings, .residual = o.crease_residual, .margin = o.margin};
+  const auto targets = detail::crease_targets(s, seg.flats, seg.region, seg.junction, x, off, adj, c);
   for (const auto& [v, t] : targets) {
     s.t[v] = s.lower_inside(v) ? t : 1 - t;
     if (zone) (*zone)[v] = 1;

@@ -740,8 +740,6 @@ struct Sharpener {
     return uint32_t(n + nv.size() - 1);
   }
 
-  // Figure 8: split the chamfer triangles; new vertices start on their
-  // edges (the surface is unchanged until they move).
   // Beyond the paper: press_with_flats placed the curved vertices next to
   // its junctions by the crease fit (fit_creases), but snapping, the
   // leftovers and the rim pockets moved the flats' rims since, and where a
@@ -755,19 +753,19 @@ struct Sharpener {
   // fit_creases a long move leaves a kink.
   void final_crease_fit() {
     if (o.final_crease_rings <= 0) return;
-    std::vector<Vec3> in(n), out(n);
-    for (size_t v = 0; v < n; ++v) {
-      in[v] = s.inside_sample(v);
-      out[v] = s.outside_sample(v);
-    }
-    const detail::CreaseFit c{o.final_crease_rings, o.final_crease_fit_rings, o.final_crease_residual, o.margin,
-                              o.final_crease_max_move};
-    for (const auto& [v, t] : detail::crease_targets(seg.flats, label, junction, x, in, out, adj_off, adj, c)) {
+    const detail::CreaseFit c{.rings = o.final_crease_rings,
+                              .fit_rings = o.final_crease_fit_rings,
+                              .residual = o.final_crease_residual,
+                              .margin = o.margin,
+                              .max_move = o.final_crease_max_move};
+    for (const auto& [v, t] : detail::crease_targets(s, seg.flats, label, junction, x, adj_off, adj, c)) {
       slide(v, t);
       ++st.final_crease_vertices;
     }
   }
 
+  // Figure 8: split the chamfer triangles; new vertices start on their
+  // edges (the surface is unchanged until they move).
   void subdivide() {
     std::unordered_map<uint64_t, uint32_t> on_edge;
     const double floor2 = 1 - std::cos(o.min_angle * kPi / 180);
