@@ -93,7 +93,8 @@ void run_press(const PressCmd& c, const Global& g) {
     for (const char* name :
          {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend", "--flat-width",
           "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations", "--wall-thickness", "--features",
-          "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain"})
+          "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain",
+          "--fixed-ends"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
   if (!c.features.empty()) {
     const MeshFormat ff = mesh_format_from_path(c.features);

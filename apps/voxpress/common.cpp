@@ -156,6 +156,9 @@ void PressCli::bind(CLI::App& cmd) {
   g->add_option("--weighting", weighting, "equal | normal | tangent (combining a stick's two proposals)")
       ->capture_default_str();
   g->add_flag("--plain", plain, "Bilaplacian of the actual neighbours, no arc-length resampling (paper Fig. 5)");
+  g->add_flag("--fixed-ends", fixed_ends,
+              "Curve pieces next to a sharp flat border keep the flat's last vertex as a fixed end (default: free "
+              "ends, aligned with the curved side)");
 }
 
 PressOptions PressCli::resolve() const {
@@ -169,6 +172,7 @@ PressOptions PressCli::resolve() const {
   else
     throw UsageError("--weighting must be equal, normal or tangent");
   o.resample = !plain;
+  o.free_ends = !fixed_ends;
   if (o.iterations < 0) throw UsageError("--iterations must be >= 0");
   if (!(o.margin > 0 && o.margin < 0.5)) throw UsageError("--margin must be in (0, 0.5)");
   if (!(o.arc_length > 0) || !(o.step > 0)) throw UsageError("--arc-length and --step must be > 0");
@@ -201,7 +205,8 @@ nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
           {"fresh", st.fresh},              {"frozen", st.frozen},
           {"seconds", st.seconds},          {"levels", o.levels},
           {"momentum", o.momentum},         {"arc_length", o.arc_length},
-          {"step", o.step},                 {"resample", o.resample}};
+          {"step", o.step},                 {"resample", o.resample},
+          {"free_ends", o.free_ends}};
 }
 
 nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what,

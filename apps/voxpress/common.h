@@ -84,10 +84,11 @@ struct PressCli {
   PressOptions options;
   std::string weighting = "equal";
   bool plain = false;
+  bool fixed_ends = false;
   CLI::Option* iterations_option = nullptr;  ///< to tell a given --iterations from the default
   CLI::Option* tolerance_option = nullptr;
   void bind(CLI::App& cmd);
-  /// The options with the weighting and --plain applied; throws UsageError.
+  /// The options with the weighting, --plain and --fixed-ends applied; throws UsageError.
   PressOptions resolve() const;
 };
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o);

@@ -1364,6 +1364,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   eo.iterations = fo->estimate_iterations;  // fixed: the flats do not depend on po.iterations
   eo.tolerance = 0;
   eo.progress = nullptr;
+  eo.free_ends = false;  // see PressOptions::free_ends
   press(est, curves, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's

@@ -41,14 +41,22 @@ namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
+// PressOptions::free_ends: pieces from barrier to barrier of at least this
+// many segments (7 vertices between the barriers) get free ends. Measured
+// 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
+// holes of plate_holes at 128^3 (docs/ARCHITECTURE.md).
+constexpr uint32_t kFreePiece = 8;
 
 // Slot of plane family a among the two families of a stick along axis b.
 inline int slot_of(int a, int b) { return a < 3 - a - b ? 0 : 1; }
 
-// A location on a polyline: point k + f (point k + 1 - point k).
+// A location on a polyline: point k + f (point k + 1 - point k); past a
+// free end (PressOptions::free_ends), that location reflected through the
+// end (mirror 1: the last point, 2: the first).
 struct Where {
   uint32_t k;
   double f;
+  uint8_t mirror = 0;
 };
 
 // The metric of a plane's index coordinates (u, v): |(du, dv)|^2 =
@@ -77,11 +85,11 @@ struct Scratch {
 };
 
 // Displacement proposals s^2 L^2(C) for the n vertices w.pos of one curve
-// (closed, or open with fixed ends), in the plane's index coordinates, and
+// (closed, or open with fixed or free ends), in the plane's index coordinates, and
 // unit tangents (index coordinates, unit in the metric) for the weightings.
 // Section 4, Fig. 4-6: virtual neighbours at arc length d, two Laplacian passes.
 void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool tangents, const Metric& g,
-                Scratch& w) {
+                Scratch& w, bool free_ends = false) {
   const Vec2* p = w.pos.data();
   double* len = w.len.data();
   Where* fwd = w.fwd.data();
@@ -113,6 +121,15 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
     for (;;) {
       if (!closed && j + 1 >= n) {
         fwd[i] = {uint32_t(n - 1), 0};
+        // Free end: the point r before the end, reflected through it.
+        if (free_ends)
+          for (size_t h = n - 1; h > 0; --h) {
+            if (r <= len[h - 1] || h == 1) {
+              fwd[i] = {uint32_t(h - 1), std::max(0.0, 1 - r * w.inv[h - 1]), 1};
+              break;
+            }
+            r -= len[h - 1];
+          }
         break;
       }
       if (r <= len[j]) {
@@ -128,6 +145,14 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
     for (;;) {
       if (!closed && j == 0) {
         bwd[i] = {0, 0};
+        if (free_ends)
+          for (size_t h = 0; h + 1 < n; ++h) {
+            if (r <= len[h] || h + 2 == n) {
+              bwd[i] = {uint32_t(h), std::min(1.0, r * w.inv[h]), 2};
+              break;
+            }
+            r -= len[h];
+          }
         break;
       }
       const size_t k = j == 0 ? n - 1 : j - 1;
@@ -139,7 +164,10 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
       j = k;
     }
   }
-  const auto point = [&](const Where& x) { return Vec2(p[x.k] + x.f * (p[next(x.k)] - p[x.k])); };
+  const auto point = [&](const Where& x) {
+    const Vec2 q = p[x.k] + x.f * (p[next(x.k)] - p[x.k]);
+    return x.mirror == 0 ? q : Vec2(2 * p[x.mirror == 1 ? n - 1 : 0] - q);
+  };
   // Pass 1: Laplacian towards the virtual neighbours.
   for (size_t i = 0; i < n; ++i) {
     const Vec2 f = point(fwd[i]), b = point(bwd[i]);
@@ -151,7 +179,11 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
     }
   }
   // Pass 2: the Laplacian of the Laplacian, interpolated at the same places.
-  const auto lap_at = [&](const Where& x) { return Vec2(lap[x.k] + x.f * (lap[next(x.k)] - lap[x.k])); };
+  // Past a free end the Laplacian is taken as 0 (the end's own, since its
+  // virtual neighbours are each other's reflection).
+  const auto lap_at = [&](const Where& x) {
+    return x.mirror != 0 ? Vec2(Vec2::Zero()) : Vec2(lap[x.k] + x.f * (lap[next(x.k)] - lap[x.k]));
+  };
   for (size_t i = 0; i < n; ++i) w.disp[i] = s2 * (lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
 }
 
@@ -311,6 +343,14 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
           for (uint32_t k = 0; k < m;) {
             uint32_t len = 1;
             while (!barrier[ids[b + (first_barrier + k + len) % m]]) ++len;
+            if (o.free_ends && len >= kFreePiece) {
+              w.resize(len - 1);
+              for (uint32_t i = 1; i < len; ++i) gather(i - 1, b + (first_barrier + k + i) % m);
+              curve_step(len - 1, false, d, s2, o.resample, weighted, g, w, true);
+              for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, w.disp[i - 1], w.tangent[i - 1]);
+              k += len;
+              continue;
+            }
             w.resize(len + 1);
             for (uint32_t i = 0; i <= len; ++i) gather(i, b + (first_barrier + k + i) % m);
             curve_step(len + 1, false, d, s2, o.resample, weighted, g, w);

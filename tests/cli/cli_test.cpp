@@ -452,6 +452,19 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   EXPECT_DOUBLE_EQ(ev2["sharp_edges"]["voxels"]["match"].get<double>(), 0.0001);
   EXPECT_LT(ev2["sharp_edges"]["voxels"]["recall"].get<double>(), ev["sharp_edges"]["voxels"]["recall"].get<double>());
   EXPECT_EQ(run_cli("-q eval " + tmp.path("b.ply") + " --volume " + tmp.path("b.nrrd") + " --sharp-match -1", &out), 2);
+  // --fixed-ends: recorded in the stats; a box has no curved piece between
+  // two barriers, so its surface does not change.
+  EXPECT_TRUE(st["pressing"]["free_ends"].get<bool>());
+  ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("fe.ply") +
+                        " --check --color-regions --fixed-ends --stats-json " + tmp.path("fe.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_FALSE(nlohmann::json::parse(std::ifstream(tmp.path("fe.json")))["pressing"]["free_ends"].get<bool>());
+  EXPECT_EQ(test::read_file(tmp.path("fe.ply")), test::read_file(tmp.path("b.ply")));
+  EXPECT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method taubin --fixed-ends", &out),
+            2);
+  EXPECT_NE(out.find("--fixed-ends applies to --method pressing only"), std::string::npos) << out;
   // --no-sharpen: the chamfered surface, vertex regions only; --features then is a usage error.
   ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("c.ply") + " --no-sharpen", &out), 0) << out;
   const Mesh chamfered = read_mesh(tmp.path("c.ply"));

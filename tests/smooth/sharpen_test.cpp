@@ -234,17 +234,21 @@ TEST(Sharpen, RimPocketsLeaveTheCurvedCreasesInPlace) {
 TEST(Sharpen, FinalCreaseFitPlacesTheRoundedCreases) {
   // Snapping, the leftovers and the rim pockets move the flats' rims after
   // press_with_flats placed the curved vertices next to its junctions; where
-  // a rim had stopped short of a crease, the curved side stayed pressed in
-  // 0.3-0.4 cell. Fitting again once the labels are final puts more of the
-  // true flat/curved creases within 0.15 voxel of a label (measured,
-  // cylinder 128 seeds 1 / 4: 0.967 / 0.977 -> 0.996 / 0.999; CAD part 128
-  // seed 4: 0.905 -> 0.928), and the result closer to the truth.
+  // a rim had stopped short of a crease, the curved side stayed pressed in.
+  // Fitting again once the labels are final puts more of the true
+  // flat/curved creases within 0.15 voxel of a label, and the result closer
+  // to the truth. Since the pieces next to the rims have free ends
+  // (PressOptions::free_ends) the curved side is pressed in less and the
+  // gain is smaller (share within 0.15 voxel, cylinder 128 seeds 1 / 4, CAD
+  // part 128 seed 4: 0.982 / 0.977 / 0.919 -> 0.985 / 0.995 / 0.932;
+  // result -> truth 0.0660 -> 0.0653 summed), so it is tested over the three.
   SharpenOptions off;
   off.final_crease_rings = 0;
   struct Case {
     ShapeKind kind;
     int seed;
   };
+  double within_off = 0, within_on = 0, rms_off = 0, rms_on = 0;
   for (const Case c : {Case{ShapeKind::cylinder, 1}, Case{ShapeKind::cylinder, 4}, Case{ShapeKind::cad_part, 4}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
     const GeneratedShape g = shape(c.kind, 128, c.seed);
@@ -258,11 +262,53 @@ TEST(Sharpen, FinalCreaseFitPlacesTheRoundedCreases) {
     EXPECT_GT(b.stats.final_crease_vertices, 100u);
     expect_valid(b.mesh, g.volume);
     const auto sharp = truth->sharp_edges(30);
-    EXPECT_GT(fraction_within(crease_distances(sharp, b.mesh), 0.15),
-              fraction_within(crease_distances(sharp, a.mesh), 0.15) + 0.015);
-    EXPECT_LT(eval(b.mesh, *truth, g.volume).result_to_truth_vox.rms,
-              eval(a.mesh, *truth, g.volume).result_to_truth_vox.rms);
+    within_off += fraction_within(crease_distances(sharp, a.mesh), 0.15);
+    within_on += fraction_within(crease_distances(sharp, b.mesh), 0.15);
+    rms_off += eval(a.mesh, *truth, g.volume).result_to_truth_vox.rms;
+    rms_on += eval(b.mesh, *truth, g.volume).result_to_truth_vox.rms;
   }
+  EXPECT_GT(within_on, within_off + 0.015) << "measured +0.034 summed";
+  EXPECT_LT(rms_on, rms_off);
+}
+
+TEST(Sharpen, FreeEndsKeepTheCurvedSideOffTheFlatsCorner) {
+  // Beyond the paper (Section 4, Fig. 7): the curve pieces between barriers
+  // have free ends, so the curved side of a sharp rim follows its own shape
+  // up to the rim instead of being pulled towards the flat's corner, and the
+  // crease fit extrapolates a side that is not pressed in. Per rotation it
+  // can go either way; over nine rotations of the cylinder at 64^3 the
+  // result is closer to the truth and more of the rims are within 0.15
+  // voxel of a label.
+  double r_fixed = 0, r_free = 0, w_fixed = 0, w_free = 0;
+  const std::vector<int> seeds{1, 2, 3, 4, 5, 6, 7, 8, 64};
+  for (const int seed : seeds) {
+    SCOPED_TRACE("cylinder 64 seed " + std::to_string(seed));
+    const GeneratedShape g = shape(ShapeKind::cylinder, 64, seed);
+    const auto truth = shape_truth(ShapeKind::cylinder, g.linear, g.translation);
+    const auto sharp = truth->sharp_edges(30);
+    StickSurface fixed = extract_sticks(g.volume), free = fixed;
+    const SliceCurves curves = build_slice_curves(fixed);
+    const FlatOptions fo;
+    PressOptions po;
+    po.free_ends = false;
+    FlatSegmentation seg_fixed, seg_free;
+    press_with_flats(fixed, curves, po, &fo, &seg_fixed);
+    po.free_ends = true;
+    press_with_flats(free, curves, po, &fo, &seg_free);
+    // The estimates keep fixed ends: the same flats either way.
+    ASSERT_EQ(seg_free.region, seg_fixed.region);
+    const SharpenResult a = sharpen(fixed, seg_fixed), b = sharpen(free, seg_free);
+    expect_valid(b.mesh, g.volume);
+    const double ra = eval(a.mesh, *truth, g.volume).result_to_truth_vox.rms;
+    const double rb = eval(b.mesh, *truth, g.volume).result_to_truth_vox.rms;
+    const double wa = fraction_within(crease_distances(sharp, a.mesh), 0.15);
+    const double wb = fraction_within(crease_distances(sharp, b.mesh), 0.15);
+    r_fixed += ra, r_free += rb, w_fixed += wa, w_free += wb;
+  }
+  // Measured: result -> truth 0.0317 -> 0.0295 (better on 6 of the 9),
+  // share of the rims within 0.15 voxel 0.905 -> 0.939.
+  EXPECT_LT(r_free, 0.95 * r_fixed);
+  EXPECT_GT(w_free, w_fixed + 0.02 * double(seeds.size()));
 }
 
 TEST(Sharpen, SnappingTakesBevelsNotCurvedFaces) {
