@@ -62,7 +62,7 @@ void register_press2d(CLI::App& app, Global& g) {
   cmd->add_flag("--invert", c->invert, "Inside = luminance at or above the threshold (bright objects)");
   cmd->add_flag("--no-pixels", c->no_pixels, "Do not draw the pixels under the contours");
   cmd->add_flag("--midpoint", c->midpoint, "Also draw the unsmoothed midpoint contours");
-  c->smooth.bind(*cmd);
+  c->smooth.bind(*cmd, false);  // no flats in 2D: no barriers
   cmd->add_option("--stats-json", c->stats_json, "Write counts and timings as JSON");
   cmd->callback([c, &g] {
     g.apply();

@@ -136,7 +136,7 @@ nlohmann::json surface_stats_json(const char* command, const std::string& input,
   return j;
 }
 
-void PressCli::bind(CLI::App& cmd) {
+void PressCli::bind(CLI::App& cmd, bool barriers) {
   auto* g = cmd.add_option_group("smoothing", "Pressing (constrained bilaplacian smoothing)");
   iterations_option = g->add_option("--iterations", options.iterations,
                                     "Maximum iterations (other methods: cap 1000 for cesn and the constraints, "
@@ -156,9 +156,10 @@ void PressCli::bind(CLI::App& cmd) {
   g->add_option("--weighting", weighting, "equal | normal | tangent (combining a stick's two proposals)")
       ->capture_default_str();
   g->add_flag("--plain", plain, "Bilaplacian of the actual neighbours, no arc-length resampling (paper Fig. 5)");
-  g->add_flag("--fixed-ends", fixed_ends,
-              "Curve pieces next to a sharp flat border keep the flat's last vertex as a fixed end (default: free "
-              "ends, aligned with the curved side)");
+  if (barriers)
+    g->add_flag("--fixed-ends", fixed_ends,
+                "Curve pieces next to a sharp flat border keep the flat's last vertex as a fixed end (default: free "
+                "ends, aligned with the curved side)");
 }
 
 PressOptions PressCli::resolve() const {

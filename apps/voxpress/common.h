@@ -87,7 +87,8 @@ struct PressCli {
   bool fixed_ends = false;
   CLI::Option* iterations_option = nullptr;  ///< to tell a given --iterations from the default
   CLI::Option* tolerance_option = nullptr;
-  void bind(CLI::App& cmd);
+  /// `barriers`: the command presses next to flats (press), so --fixed-ends applies.
+  void bind(CLI::App& cmd, bool barriers = true);
   /// The options with the weighting, --plain and --fixed-ends applied; throws UsageError.
   PressOptions resolve() const;
 };
