@@ -343,18 +343,13 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
           for (uint32_t k = 0; k < m;) {
             uint32_t len = 1;
             while (!barrier[ids[b + (first_barrier + k + len) % m]]) ++len;
-            if (o.free_ends && len >= kFreePiece) {
-              w.resize(len - 1);
-              for (uint32_t i = 1; i < len; ++i) gather(i - 1, b + (first_barrier + k + i) % m);
-              curve_step(len - 1, false, d, s2, o.resample, weighted, g, w, true);
-              for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, w.disp[i - 1], w.tangent[i - 1]);
-              k += len;
-              continue;
-            }
-            w.resize(len + 1);
-            for (uint32_t i = 0; i <= len; ++i) gather(i, b + (first_barrier + k + i) % m);
-            curve_step(len + 1, false, d, s2, o.resample, weighted, g, w);
-            for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, w.disp[i], w.tangent[i]);
+            // Free ends: the piece without its two barriers (PressOptions::free_ends).
+            const bool loose = o.free_ends && len >= kFreePiece;
+            const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
+            w.resize(count);
+            for (uint32_t i = 0; i < count; ++i) gather(i, b + (first_barrier + k + lo + i) % m);
+            curve_step(count, false, d, s2, o.resample, weighted, g, w, loose);
+            for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, w.disp[i - lo], w.tangent[i - lo]);
             k += len;
           }
         }

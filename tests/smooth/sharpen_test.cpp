@@ -286,18 +286,18 @@ TEST(Sharpen, FreeEndsKeepTheCurvedSideOffTheFlatsCorner) {
     const GeneratedShape g = shape(ShapeKind::cylinder, 64, seed);
     const auto truth = shape_truth(ShapeKind::cylinder, g.linear, g.translation);
     const auto sharp = truth->sharp_edges(30);
-    StickSurface fixed = extract_sticks(g.volume), free = fixed;
-    const SliceCurves curves = build_slice_curves(fixed);
+    StickSurface pinned = extract_sticks(g.volume), loose = pinned;
+    const SliceCurves curves = build_slice_curves(pinned);
     const FlatOptions fo;
     PressOptions po;
     po.free_ends = false;
     FlatSegmentation seg_fixed, seg_free;
-    press_with_flats(fixed, curves, po, &fo, &seg_fixed);
+    press_with_flats(pinned, curves, po, &fo, &seg_fixed);
     po.free_ends = true;
-    press_with_flats(free, curves, po, &fo, &seg_free);
+    press_with_flats(loose, curves, po, &fo, &seg_free);
     // The estimates keep fixed ends: the same flats either way.
     ASSERT_EQ(seg_free.region, seg_fixed.region);
-    const SharpenResult a = sharpen(fixed, seg_fixed), b = sharpen(free, seg_free);
+    const SharpenResult a = sharpen(pinned, seg_fixed), b = sharpen(loose, seg_free);
     expect_valid(b.mesh, g.volume);
     const double ra = eval(a.mesh, *truth, g.volume).result_to_truth_vox.rms;
     const double rb = eval(b.mesh, *truth, g.volume).result_to_truth_vox.rms;

@@ -68,14 +68,14 @@ struct PressOptions {
   bool resample = true;
   /// Beyond the paper (Section 4, Fig. 7: junction-aware smoothing): an
   /// open piece of curve between two barrier vertices (frozen flat vertices
-  /// next to a junction) is smoothed without them, its ends free: the
-  /// virtual neighbours past an end continue the piece's last segment, so
-  /// the curved side of a sharp crease follows its own shape up to the
-  /// crease instead of being pulled towards the flat's corner. Pieces with
-  /// fewer than 7 vertices between their barriers (a thin wall's rim, a
-  /// small hole) keep the barriers as fixed ends, as do all pieces when
-  /// false. press_with_flats turns it off for its estimates (measured:
-  /// docs/ARCHITECTURE.md, Pressing with flats).
+  /// next to a junction) is smoothed without them, its ends free: a virtual
+  /// neighbour past an end is the point as far back from the end, reflected
+  /// through it. So the curved side of a sharp crease follows its own shape
+  /// up to the crease instead of being pulled towards the flat's corner.
+  /// Pieces with fewer than 7 vertices between their barriers (a thin
+  /// wall's rim, a small hole) keep the barriers as fixed ends, as do all
+  /// pieces when false. press_with_flats turns it off for its estimates
+  /// (measured: docs/ARCHITECTURE.md, Flats, Fig. 7 — free ends).
   bool free_ends = true;
   Progress* progress = nullptr;
 };
