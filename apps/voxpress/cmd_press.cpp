@@ -14,7 +14,7 @@ struct PressCmd {
   FlatOptions flats;
   SharpenOptions sharpen;
   std::string features;
-  bool no_flats = false, no_sharpen = false, color_regions = false;
+  bool no_flats = false, no_sharpen = false, no_curved_creases = false, color_regions = false;
   bool ascii = false, check = false;
   std::string method = "pressing";
   MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
@@ -39,6 +39,7 @@ nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
           {"junctions", st.junctions},
           {"barriers", st.barriers},
           {"crease_vertices", st.crease_vertices},
+          {"curved_crease_vertices", st.curved_crease_vertices},
           {"votes", st.votes},
           {"voters", st.voters},
           {"cells", st.cells},
@@ -57,6 +58,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"tangent_planes", st.tangent_planes},
           {"wall_vertices", st.wall_vertices},
           {"final_crease_vertices", st.final_crease_vertices},
+          {"curved_crease_vertices", st.curved_crease_vertices},
           {"snapped", st.snapped},
           {"cut_back", st.cut_back},
           {"sharp_edges", st.sharp_edges},
@@ -94,7 +96,7 @@ void run_press(const PressCmd& c, const Global& g) {
          {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend", "--flat-width",
           "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations", "--wall-thickness", "--features",
           "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain",
-          "--fixed-ends"})
+          "--fixed-ends", "--no-curved-creases"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
   if (!c.features.empty()) {
     const MeshFormat ff = mesh_format_from_path(c.features);
@@ -109,8 +111,10 @@ void run_press(const PressCmd& c, const Global& g) {
     throw UsageError("--flat-tolerance and --flat-bend must be > 0, --flat-width >= 0");
   so.flats = !c.no_flats;
   so.flat = c.flats;
+  so.flat.curved_creases = !c.no_curved_creases;
   so.sharpen = !c.no_sharpen;
   so.sharp = c.sharpen;
+  so.sharp.curved_creases = !c.no_curved_creases;
   so.color_regions = c.color_regions;
   if (!pressing) {  // pressing reads these from so.press, with its own defaults
     if (c.smooth.iterations_option->count()) so.overrides.iterations = c.smooth.options.iterations;
@@ -208,6 +212,9 @@ void register_press(CLI::App& app, Global& g) {
                 "Rounds placing the curved vertices next to a sharp flat border by the curved side's quadric fit (0: off)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
+  f->add_flag("--no-curved-creases", c->no_curved_creases,
+              "Leave creases between two curved faces rounded and unlabelled (they are placed by both sides' quadric "
+              "fits and sharpened by default)");
   f->add_flag("--color-regions", c->color_regions,
               "Colour the vertices by region (flats, curved grey, junctions orange, sharp curves red)");
   auto* sh = cmd->add_option_group("sharpen", "Sharp edge recovery (needs flats)");

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "crease_fit.h"
 #include "quadric.h"
@@ -19,6 +20,8 @@ namespace voxpress {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kStabSolves = 20;     // Quadric::stab's least-squares solves
+constexpr size_t kSidePoints = 12;  // fewest points of a curved crease's side (Quadric::fit's minimum)
 
 }  // namespace
 
@@ -89,6 +92,159 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
   return targets;
 }
 
+std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
+                                                const std::vector<uint8_t>& skip, const std::vector<Vec3>& x,
+                                                const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
+                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals) {
+  const size_t n = region.size();
+  const Mat3 Minv_t = sticks.lattice.index_to_physical_matrix().inverse().transpose();
+  std::vector<Vec3> vn(n, Vec3::Zero());
+  for (const Triangle& t : sticks.triangles) {
+    const Vec3 fn = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+    for (uint32_t v : t) vn[v] += fn;
+  }
+  for (auto& v : vn) v = (Minv_t * v).normalized();
+  auto deg = [](const Vec3& a, const Vec3& b) {
+    return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / std::numbers::pi;
+  };
+  std::vector<uint8_t> band(n, 0);
+  for (size_t v = 0; v < n; ++v) {
+    if (region[v] >= 0 || skip[v]) continue;
+    double mx = 0;
+    for (uint32_t k = off[v]; k < off[v + 1]; ++k)
+      if (region[adj[k]] < 0) mx = std::max(mx, deg(vn[v], vn[adj[k]]));
+    band[v] = mx >= c.band_angle;
+  }
+  std::vector<uint32_t> members;
+  for (size_t v = 0; v < n; ++v)
+    if (band[v]) members.push_back(uint32_t(v));
+  std::vector<CurvedCrease> found(members.size(), CurvedCrease{0, std::numeric_limits<double>::quiet_NaN(), {}, {}});
+  tbb::enumerable_thread_specific<RingScratch> scratch;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    RingScratch& rs = scratch.local();
+    std::vector<uint32_t> P;
+    std::vector<uint8_t> side, keep;
+    std::vector<Vec3> pa, pb, ia, xa, ib, xb;
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const uint32_t v = members[i];
+      rings_around(v, c.rings, off, adj, [&](uint32_t w) { return region[w] < 0; }, rs);
+      P.clear();
+      for (const auto& [w, d] : rs.out)
+        if (!band[w] && !skip[w]) P.push_back(w);
+      if (P.size() < 2 * kSidePoints) continue;
+      // Two sides: 2-means on the normals, seeded by the normal farthest
+      // from v's and the one farthest from that.
+      uint32_t a = P[0], b = P[0];
+      for (uint32_t w : P)
+        if (vn[w].dot(vn[v]) < vn[a].dot(vn[v])) a = w;
+      for (uint32_t w : P)
+        if (vn[w].dot(vn[a]) < vn[b].dot(vn[a])) b = w;
+      Vec3 ma = vn[a], mb = vn[b];
+      side.assign(P.size(), 0);
+      for (int it = 0; it < 4; ++it) {
+        Vec3 sa = Vec3::Zero(), sb = Vec3::Zero();
+        for (size_t k = 0; k < P.size(); ++k) {
+          side[k] = vn[P[k]].dot(ma) < vn[P[k]].dot(mb);
+          (side[k] ? sb : sa) += vn[P[k]];
+        }
+        if (sa.isZero() || sb.isZero()) break;
+        ma = sa.normalized();
+        mb = sb.normalized();
+      }
+      if (deg(ma, mb) < c.sharp_angle) continue;
+      // Each side's points (kept ones) and outward direction (the sum of
+      // their sticks' inside -> outside directions).
+      keep.assign(P.size(), 1);
+      Vec3 oa, ob;
+      auto split = [&] {
+        pa.clear();
+        pb.clear();
+        oa.setZero();
+        ob.setZero();
+        for (size_t k = 0; k < P.size(); ++k) {
+          if (!keep[k]) continue;
+          const Vec3 d = sticks.outside_sample(P[k]) - sticks.inside_sample(P[k]);
+          (side[k] ? pb : pa).push_back(x[P[k]]);
+          (side[k] ? ob : oa) += d;
+        }
+        return pa.size() >= kSidePoints && pb.size() >= kSidePoints;
+      };
+      Quadric QA, QB;
+      if (!split() || !QA.fit(pa, oa) || !QB.fit(pb, ob)) continue;
+      // Trimming: each point goes to the nearer quadric, and points farther
+      // than `trim` from both (the rounded crease the band threshold left
+      // in) are dropped; then both are refitted.
+      bool fitted = true;
+      for (uint32_t round = 0; round < c.trim_rounds && fitted; ++round) {
+        for (size_t k = 0; k < P.size(); ++k) {
+          const Vec3& p = x[P[k]];
+          const double da = std::abs(QA.n.dot(p - QA.foot(p))), db = std::abs(QB.n.dot(p - QB.foot(p)));
+          side[k] = db < da;
+          keep[k] = std::min(da, db) <= c.trim;
+        }
+        fitted = split() && QA.fit(pa, oa) && QB.fit(pb, ob);
+      }
+      if (!fitted || QA.residual > c.residual || QB.residual > c.residual) continue;
+      Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
+      for (const Vec3& p : pa) ca += p;
+      for (const Vec3& p : pb) cb += p;
+      ca /= double(pa.size());
+      cb /= double(pb.size());
+      ia.clear();
+      xa.clear();
+      ib.clear();
+      xb.clear();
+      for (size_t k = 0; k < P.size(); ++k) {
+        if (!keep[k]) continue;
+        (side[k] ? ib : ia).push_back(sticks.inside_sample(P[k]));
+        (side[k] ? xb : xa).push_back(sticks.outside_sample(P[k]));
+      }
+      QA.stab(pa, ia, xa, c.stab_eps, c.stab_weight, kStabSolves);
+      QB.stab(pb, ib, xb, c.stab_eps, c.stab_weight, kStabSolves);
+      const double ga = QA.n.dot(cb - QA.foot(cb)), gb = QB.n.dot(ca - QB.foot(ca));
+      if ((ga < 0) != (gb < 0)) continue;
+      const bool convex = ga < 0;
+      const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
+      const double tv = (x[v] - in).dot(out - in);
+      // Where the stick leaves a side's solid; a stick the quadric does not
+      // cross is inside it (or outside) all along.
+      auto leave = [&](const Quadric& Q) {
+        const double t = Q.exit(in, out, tv, -1, 2);
+        if (!std::isnan(t)) return t;
+        const double gi = Q.n.dot(in - Q.foot(in)), go = Q.n.dot(out - Q.foot(out));
+        if (gi < 0 && go < 0) return kInf;
+        if (gi > 0 && go > 0) return -kInf;
+        return t;
+      };
+      const double ta = leave(QA), tb = leave(QB);
+      if (std::isnan(ta) || std::isnan(tb)) continue;
+      const double t = std::clamp(convex ? std::min(ta, tb) : std::max(ta, tb), c.margin, 1 - c.margin);
+      if (std::abs(t - tv) > c.max_move) continue;
+      const bool a_side = convex ? ta <= tb : ta >= tb;
+      const Vec3 q = in + t * (out - in);
+      const Quadric& C = a_side ? QA : QB;
+      const Quadric& O = a_side ? QB : QA;
+      if (std::abs(O.n.dot(q - O.foot(q))) > c.other_distance) continue;  // no crease here
+      CurvedCrease& f = found[i];
+      f.v = v;
+      f.t = t;
+      Vec3 foot = C.foot(q);
+      f.chosen.n = C.normal_at(foot);
+      f.chosen.c = f.chosen.n.dot(foot);
+      foot = O.foot(q);
+      f.other.n = O.normal_at(foot);
+      f.other.c = f.other.n.dot(foot);
+      if (deg((Minv_t * f.chosen.n).normalized(), (Minv_t * f.other.n).normalized()) < c.sharp_angle)
+        f.t = std::numeric_limits<double>::quiet_NaN();
+    }
+  });
+  std::vector<CurvedCrease> out;
+  for (const auto& f : found)
+    if (!std::isnan(f.t)) out.push_back(f);
+  if (normals) *normals = std::move(vn);
+  return out;
+}
+
 }  // namespace detail
 
 size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o, std::vector<uint8_t>* zone) {
@@ -107,6 +263,29 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
     if (zone) (*zone)[v] = 1;
   }
   return targets.size();
+}
+
+size_t fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o,
+                          std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed) {
+  const size_t n = s.stick_count();
+  if (!o.curved_creases || seg.region.size() != n) return 0;
+  std::vector<uint32_t> off, adj;
+  detail::vertex_adjacency(n, s.triangles, off, adj);
+  std::vector<Vec3> x(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
+  fixed.resize(n, 0);
+  std::vector<uint8_t> skip(n);
+  for (size_t v = 0; v < n; ++v) skip[v] = fixed[v] || (!seg.junction.empty() && seg.junction[v]);
+  detail::CurvedCreaseFit c;
+  c.sharp_angle = o.junction_angle;
+  c.margin = o.margin;
+  const auto found = detail::curved_crease_targets(s, seg.region, skip, x, off, adj, c);
+  for (const auto& f : found) {
+    s.t[f.v] = s.lower_inside(f.v) ? f.t : 1 - f.t;
+    fixed[f.v] = 1;
+    if (placed) (*placed)[f.v] = 1;
+  }
+  return found.size();
 }
 
 }  // namespace voxpress

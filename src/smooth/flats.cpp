@@ -1398,7 +1398,8 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
-  // by the curved side's fit (fit_creases), then the rest pressed again
+  // by the curved side's fit (fit_creases), and those of creases between
+  // two curved faces by both sides' fits (fit_curved_creases), then the rest pressed again
   // around them; the iterations are shared out so the cost is unchanged.
   // Each round re-presses a fifth of the iterations (fewer past 4 rounds, so
   // the first press keeps a share).
@@ -1411,12 +1412,17 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     std::vector<uint8_t> fixed;
     const auto t2 = std::chrono::steady_clock::now();
     seg.stats.crease_vertices = fit_creases(s, seg, *fo, &fixed);
+    // The curved crease vertices cut the slice curves too (barriers), so
+    // neither side's bilaplacian reaches across them.
+    std::vector<uint8_t> barrier = seg.barrier;
+    barrier.resize(s.stick_count(), 0);
+    seg.stats.curved_crease_vertices = fit_curved_creases(s, seg, *fo, fixed, &barrier);
     seg.stats.seconds_creases += seconds_since(t2);
     for (size_t v = 0; v < fixed.size(); ++v) fixed[v] |= seg.region[v] >= 0;
     PressOptions again = po;
     again.iterations = rest;
     again.levels = 1;  // the fine stage goes on
-    const PressStats ps = press(s, curves, again, fixed, seg.barrier);
+    const PressStats ps = press(s, curves, again, fixed, barrier);
     st.press.iterations += ps.iterations;
     st.press.seconds += ps.seconds;
     st.press.last_max_change = ps.last_max_change;

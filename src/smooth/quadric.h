@@ -43,6 +43,58 @@ struct Quadric {
     return true;
   }
 
+  // Refit (after fit) so that the surface also separates each stick's
+  // samples: ins[k] at least eps below it along n, outs[k] at least eps
+  // above. The pressed points near a rounded crease are biased (pressed
+  // in, then overshooting outwards for a few cells), and the sticks are
+  // not: each violated side joins the least squares as a target eps past
+  // its sample with `weight` (a squared-hinge penalty), once violated kept
+  // (so the active set only grows and the loop ends), at most `iters`
+  // solves. The residual is then the points' RMS distance to the refit.
+  void stab(const std::vector<Vec3>& pts, const std::vector<Vec3>& ins, const std::vector<Vec3>& outs, double eps,
+            double weight, int iters) {
+    auto row = [&](const Vec3& p, Eigen::Matrix<double, 6, 1>& r) {
+      const Vec3 d = p - m;
+      const double a = u.dot(d), b = w.dot(d);
+      r << a * a, a * b, b * b, a, b, 1;
+      return n.dot(d);
+    };
+    Eigen::Matrix<double, 6, 6> N0 = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> r0 = Eigen::Matrix<double, 6, 1>::Zero(), r;
+    for (const Vec3& p : pts) {
+      const double z = row(p, r);
+      N0 += r * r.transpose();
+      r0 += z * r;
+    }
+    std::vector<uint8_t> active(2 * ins.size(), 0);
+    for (int it = 0; it < iters; ++it) {
+      bool changed = false;
+      for (size_t k = 0; k < ins.size(); ++k) {
+        double z = row(ins[k], r);
+        if (z - r.dot(q) > -eps && !active[2 * k]) active[2 * k] = 1, changed = true;
+        z = row(outs[k], r);
+        if (z - r.dot(q) < eps && !active[2 * k + 1]) active[2 * k + 1] = 1, changed = true;
+      }
+      if (!changed) break;
+      Eigen::Matrix<double, 6, 6> N = N0;
+      Eigen::Matrix<double, 6, 1> rhs = r0;
+      for (size_t k = 0; k < ins.size(); ++k)
+        for (int e = 0; e < 2; ++e) {
+          if (!active[2 * k + size_t(e)]) continue;
+          const double z = row(e ? outs[k] : ins[k], r) + (e ? -eps : eps);
+          N += weight * r * r.transpose();
+          rhs += weight * z * r;
+        }
+      q = N.ldlt().solve(rhs);
+    }
+    double ss = 0;
+    for (const Vec3& p : pts) {
+      const double z = row(p, r);
+      ss += (z - r.dot(q)) * (z - r.dot(q));
+    }
+    residual = std::sqrt(ss / double(pts.size()));
+  }
+
   // The surface point above (or below) p along n.
   Vec3 foot(const Vec3& p) const {
     const Vec3 d = p - m;

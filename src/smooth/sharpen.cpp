@@ -209,9 +209,12 @@ struct Sharpener {
   }
 
   // Section 5: an edge whose ends lie on two different faces (two flats, or
-  // a flat and a curved junction vertex).
+  // a flat and a curved junction vertex; beyond the paper, the two sides of
+  // a curved/curved crease, curved_creases).
   bool chamfer(uint32_t u, uint32_t v) const {
     const int32_t a = label[u], b = label[v];
+    if (a < 0 && b < 0 && crease_side[u] && crease_side[v])  // a curved/curved crease (curved_creases)
+      return angle_deg(plane[u].n, plane[v].n) >= o.sharp_angle;
     if (a == b) return false;
     if (a >= 0 && b >= 0) {
       return degrees_between(seg.flats[size_t(a)].normal, seg.flats[size_t(b)].normal) >= o.min_angle;
@@ -764,6 +767,49 @@ struct Sharpener {
     }
   }
 
+  // Beyond the paper: creases between two curved faces (fandisk). Once the
+  // labels are final, the band vertices of such creases are placed again by
+  // their two sides' quadrics (detail::curved_crease_targets, as in
+  // press_with_flats' rounds), along their sticks; each keeps its side's
+  // tangent plane, and a curved neighbour whose normal is closer to the
+  // other side's takes that one. Edges between two such vertices whose
+  // planes meet at `sharp_angle` or more are chamfer edges (chamfer()), so
+  // subdivide() inserts the crease as for a flat border.
+  std::vector<uint8_t> crease_side;  // per original vertex: 1 placed on a curved crease, 2 its other side's neighbour
+  void curved_creases() {
+    crease_side.assign(n, 0);
+    if (!o.curved_creases) return;
+    detail::CurvedCreaseFit c;
+    c.sharp_angle = o.sharp_angle;
+    c.margin = o.margin;
+    std::vector<Vec3> normal;
+    const auto found = detail::curved_crease_targets(s, label, junction, x, adj_off, adj, c, &normal);
+    std::vector<Plane> other(n);
+    for (const auto& f : found) {
+      slide(f.v, f.t);
+      if (plane_state[f.v] != 0) continue;
+      crease_side[f.v] = 1;
+      plane[f.v] = f.chosen;
+      other[f.v] = f.other;
+      plane_state[f.v] = 1;
+    }
+    st.curved_crease_vertices = found.size();
+    for (const auto& f : found) {
+      const uint32_t v = f.v;
+      if (crease_side[v] != 1) continue;
+      const Vec3 mine = physical_normal(plane[v].n), theirs = physical_normal(other[v].n);
+      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+        const uint32_t w = adj[k];
+        if (label[w] >= 0 || junction[w] || plane_state[w] != 0) continue;
+        if (normal[w].dot(theirs) > normal[w].dot(mine)) {
+          crease_side[w] = 2;
+          plane[w] = other[v];
+          plane_state[w] = 1;
+        }
+      }
+    }
+  }
+
   // Figure 8: split the chamfer triangles; new vertices start on their
   // edges (the surface is unchanged until they move).
   void subdivide() {
@@ -1063,6 +1109,7 @@ struct Sharpener {
       join_leftovers();
       fit_walls();
       final_crease_fit();
+      curved_creases();
       subdivide();
     } else {
       tris = s.triangles;

@@ -465,6 +465,21 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   EXPECT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method taubin --fixed-ends", &out),
             2);
   EXPECT_NE(out.find("--fixed-ends applies to --method pressing only"), std::string::npos) << out;
+  // --no-curved-creases: a box has no crease between two curved faces, so
+  // the counts are 0 and the surface does not change.
+  EXPECT_EQ(st["flats"]["curved_crease_vertices"].get<size_t>(), 0u);
+  EXPECT_EQ(st["sharpen"]["curved_crease_vertices"].get<size_t>(), 0u);
+  ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("nc.ply") +
+                        " --check --color-regions --no-curved-creases",
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(test::read_file(tmp.path("nc.ply")), test::read_file(tmp.path("b.ply")));
+  EXPECT_EQ(
+      run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method cesn --no-curved-creases",
+              &out),
+      2);
+  EXPECT_NE(out.find("--no-curved-creases applies to --method pressing only"), std::string::npos) << out;
   // --no-sharpen: the chamfered surface, vertex regions only; --features then is a usage error.
   ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("c.ply") + " --no-sharpen", &out), 0) << out;
   const Mesh chamfered = read_mesh(tmp.path("c.ply"));

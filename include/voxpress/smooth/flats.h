@@ -132,6 +132,11 @@ struct FlatOptions {
   int crease_fit_rings = 5;
   double crease_residual = 0.04;
   int crease_rounds = 4;
+  /// Beyond the paper, fit_curved_creases: in the same rounds, the curved
+  /// vertices of creases between two curved faces (normals turning by
+  /// `junction_angle` or more across a narrow band) are placed where their
+  /// sticks leave the two sides' quadrics, fitted a few rings away.
+  bool curved_creases = true;
   Progress* progress = nullptr;
 };
 
@@ -150,7 +155,8 @@ struct FlatStats {
   size_t junctions = 0, barriers = 0;
   double seconds_estimate = 0, seconds_detect = 0, seconds_junctions = 0;
   size_t crease_vertices = 0;  ///< vertices fit_creases placed (last round)
-  double seconds_creases = 0;  ///< all rounds of fit_creases
+  size_t curved_crease_vertices = 0;  ///< vertices fit_curved_creases placed (last round)
+  double seconds_creases = 0;  ///< all rounds of fit_creases and fit_curved_creases
 };
 
 /// The segmentation of a stick surface into flats and the curved rest.
@@ -181,6 +187,15 @@ void apply_flats(StickSurface& surface, const FlatSegmentation& flats);
 /// (optional) flags them.
 size_t fit_creases(StickSurface& surface, const FlatSegmentation& flats, const FlatOptions& options,
                    std::vector<uint8_t>* zone = nullptr);
+
+/// Beyond the paper: places the curved vertices of creases between two
+/// curved faces (a band where the normals turn fast, whose two sides fit
+/// quadrics meeting at `junction_angle` or more) where their sticks leave
+/// the two quadrics' solid; vertices already `fixed` (the flat crease zone)
+/// and junctions are left alone. Flags the placed ones in `fixed` and, when
+/// given, in `placed`; returns how many.
+size_t fit_curved_creases(StickSurface& surface, const FlatSegmentation& flats, const FlatOptions& options,
+                          std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed = nullptr);
 
 struct FeaturePressStats {
   PressStats press;

@@ -15,8 +15,10 @@
 //     Beyond the paper, the curved vertices next to the final junctions are
 //     placed again by the crease fit (`final_crease_rings`).
 //  1. Chamfer edges join vertices of two different regions (two flats, or a
-//     flat and a curved junction vertex); smooth flat/curved borders (no
-//     junction) and flats meeting at less than `min_angle` are left alone.
+//     flat and a curved junction vertex; beyond the paper, also the two
+//     sides of a crease between curved faces, `curved_creases`); smooth
+//     flat/curved borders (no junction) and flats meeting at less than
+//     `min_angle` are left alone.
 //     Each chamfer edge gets a new vertex; a triangle with one chamfer edge
 //     becomes 2 triangles, with two 3, with three 6 around a new corner vertex.
 //  2. Each side of a chamfer edge has a plane: a flat's own plane, or for a
@@ -101,6 +103,10 @@ struct SharpenOptions {
   int final_crease_fit_rings = 5;
   double final_crease_residual = 0.04;
   double final_crease_max_move = 0.3;
+  /// Beyond the paper: creases between two curved faces are placed by their
+  /// sides' quadrics and sharpened like flat borders (curved_creases in
+  /// sharpen.cpp; press_with_flats does the placing too, FlatOptions).
+  bool curved_creases = true;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -114,6 +120,7 @@ struct SharpenStats {
   size_t tangent_planes = 0;          ///< curved sides whose plane is their quadric's tangent plane
   size_t wall_vertices = 0;           ///< vertices given a thin wall's plane (fit_walls)
   size_t final_crease_vertices = 0;   ///< curved vertices placed again by the crease fit (final_crease_fit)
+  size_t curved_crease_vertices = 0;  ///< vertices placed on creases between two curved faces (curved_creases)
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
