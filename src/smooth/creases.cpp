@@ -152,20 +152,22 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
         mb = sb.normalized();
       }
       if (deg(ma, mb) < c.sharp_angle) continue;
-      // Each side's points (kept ones) and outward direction (the sum of
-      // their sticks' inside -> outside directions).
+      // Each side's points (kept ones), their sticks' samples and the
+      // side's outward direction (the sum of its sticks' inside -> outside
+      // directions).
       keep.assign(P.size(), 1);
       Vec3 oa, ob;
       auto split = [&] {
-        pa.clear();
-        pb.clear();
+        for (auto* list : {&pa, &pb, &ia, &xa, &ib, &xb}) list->clear();
         oa.setZero();
         ob.setZero();
         for (size_t k = 0; k < P.size(); ++k) {
           if (!keep[k]) continue;
-          const Vec3 d = sticks.outside_sample(P[k]) - sticks.inside_sample(P[k]);
+          const Vec3 in = sticks.inside_sample(P[k]), out = sticks.outside_sample(P[k]);
           (side[k] ? pb : pa).push_back(x[P[k]]);
-          (side[k] ? ob : oa) += d;
+          (side[k] ? ib : ia).push_back(in);
+          (side[k] ? xb : xa).push_back(out);
+          (side[k] ? ob : oa) += out - in;
         }
         return pa.size() >= kSidePoints && pb.size() >= kSidePoints;
       };
@@ -190,15 +192,6 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       for (const Vec3& p : pb) cb += p;
       ca /= double(pa.size());
       cb /= double(pb.size());
-      ia.clear();
-      xa.clear();
-      ib.clear();
-      xb.clear();
-      for (size_t k = 0; k < P.size(); ++k) {
-        if (!keep[k]) continue;
-        (side[k] ? ib : ia).push_back(sticks.inside_sample(P[k]));
-        (side[k] ? xb : xa).push_back(sticks.outside_sample(P[k]));
-      }
       QA.stab(pa, ia, xa, c.stab_eps, c.stab_weight, kStabSolves);
       QB.stab(pb, ib, xb, c.stab_eps, c.stab_weight, kStabSolves);
       const double ga = QA.n.dot(cb - QA.foot(cb)), gb = QB.n.dot(ca - QB.foot(ca));

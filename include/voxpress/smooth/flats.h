@@ -67,8 +67,10 @@
 // clamped bilaplacian; the paper's Fig. 7 alignment was tried and dropped,
 // docs/ARCHITECTURE.md). Instead, beyond the paper, fit_creases places the
 // fresh vertices near a junction from a quadric fitted to the curved side
-// farther away, extrapolated up to the flat (press_with_flats alternates it
-// with short presses of the rest).
+// farther away, extrapolated up to the flat, and fit_curved_creases places
+// the creases between two curved faces from quadrics fitted on both sides,
+// those vertices also cutting the slice curves (press_with_flats alternates
+// both with short presses of the rest).
 #pragma once
 
 #include <array>
