@@ -135,9 +135,10 @@ struct FlatOptions {
   double crease_residual = 0.04;
   int crease_rounds = 4;
   /// Beyond the paper, fit_curved_creases: in the same rounds, the curved
-  /// vertices of creases between two curved faces (normals turning by
-  /// `junction_angle` or more across a narrow band) are placed where their
-  /// sticks leave the two sides' quadrics, fitted a few rings away.
+  /// vertices of creases between two curved faces (a narrow band where the
+  /// normals turn fast, whose two sides meet at `junction_angle` or more)
+  /// are placed where their sticks leave the two sides' quadrics, fitted a
+  /// few rings away.
   bool curved_creases = true;
   Progress* progress = nullptr;
 };
