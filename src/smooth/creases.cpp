@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 
 #include "crease_fit.h"
 #include "quadric.h"
@@ -104,15 +103,12 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
     for (uint32_t v : t) vn[v] += fn;
   }
   for (auto& v : vn) v = (Minv_t * v).normalized();
-  auto deg = [](const Vec3& a, const Vec3& b) {
-    return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / std::numbers::pi;
-  };
   std::vector<uint8_t> band(n, 0);
   for (size_t v = 0; v < n; ++v) {
     if (region[v] >= 0 || skip[v]) continue;
     double mx = 0;
     for (uint32_t k = off[v]; k < off[v + 1]; ++k)
-      if (region[adj[k]] < 0) mx = std::max(mx, deg(vn[v], vn[adj[k]]));
+      if (region[adj[k]] < 0) mx = std::max(mx, degrees_between(vn[v], vn[adj[k]]));
     band[v] = mx >= c.band_angle;
   }
   std::vector<uint32_t> members;
@@ -151,7 +147,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
         ma = sa.normalized();
         mb = sb.normalized();
       }
-      if (deg(ma, mb) < c.sharp_angle) continue;
+      if (degrees_between(ma, mb) < c.sharp_angle) continue;
       // Each side's points (kept ones), their sticks' samples and the
       // side's outward direction (the sum of its sticks' inside -> outside
       // directions).
@@ -227,7 +223,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       foot = O.foot(q);
       f.other.n = O.normal_at(foot);
       f.other.c = f.other.n.dot(foot);
-      if (deg((Minv_t * f.chosen.n).normalized(), (Minv_t * f.other.n).normalized()) < c.sharp_angle)
+      if (degrees_between((Minv_t * f.chosen.n).normalized(), (Minv_t * f.other.n).normalized()) < c.sharp_angle)
         f.t = std::numeric_limits<double>::quiet_NaN();
     }
   });

@@ -895,7 +895,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       Plane P;
       if (!constrained_fit(S, inner, pts, planes[f].n, kSideMargin, P, sides[f], o.center_planes ? &members[f] : nullptr))
         continue;
-      if (std::acos(std::clamp(P.n.dot(planes[f].n), -1.0, 1.0)) * 180 / kPi > kCreaseTurn) continue;
+      if (detail::degrees_between(P.n, planes[f].n) > kCreaseTurn) continue;
       planes[f] = P;
       moved[f] = 1;
       again = true;

@@ -24,6 +24,7 @@
 namespace voxpress {
 namespace {
 
+using detail::degrees_between;
 using detail::Plane;
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr double kPi = std::numbers::pi;
@@ -44,7 +45,6 @@ constexpr uint8_t kRimStrip = 3;  // in a strip's pocket next to a curved face (
 
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
 
-double degrees_between(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / kPi; }
 
 // Is z in the closed tetrahedron (a, b, c, d)? A flat tetrahedron counts z
 // when z is coplanar with it (conservative).
@@ -790,26 +790,24 @@ struct Sharpener {
     c.margin = o.margin;
     std::vector<Vec3> normal;
     const auto found = detail::curved_crease_targets(s, label, junction, x, adj_off, adj, c, &normal);
-    std::vector<Plane> other(n);
     for (const auto& f : found) {
       slide(f.v, f.t);
       if (plane_state[f.v] != 0) continue;
       crease_side[f.v] = 1;
       plane[f.v] = f.chosen;
-      other[f.v] = f.other;
       plane_state[f.v] = 1;
     }
     st.curved_crease_vertices = found.size();
     for (const auto& f : found) {
       const uint32_t v = f.v;
       if (crease_side[v] != 1) continue;
-      const Vec3 mine = physical_normal(plane[v].n), theirs = physical_normal(other[v].n);
+      const Vec3 mine = physical_normal(f.chosen.n), theirs = physical_normal(f.other.n);
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
         const uint32_t w = adj[k];
         if (label[w] >= 0 || junction[w] || plane_state[w] != 0) continue;
         if (normal[w].dot(theirs) > normal[w].dot(mine)) {
           crease_side[w] = 2;
-          plane[w] = other[v];
+          plane[w] = f.other;
           plane_state[w] = 1;
         }
       }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <type_traits>
 #include <vector>
 
@@ -14,6 +15,11 @@
 #include "voxpress/core/types.h"
 
 namespace voxpress::detail {
+
+// Degrees between unit vectors a and b.
+inline double degrees_between(const Vec3& a, const Vec3& b) {
+  return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180 / std::numbers::pi;
+}
 
 // Oriented plane n . x = c (index space), inside at n . x < c.
 struct Plane {
