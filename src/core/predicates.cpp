@@ -270,8 +270,13 @@ bool triangles_intersect(const Vec3 (&ta)[3], const uint32_t (&ia)[3], const Vec
     return segment_intersects_triangle(a1, a2, tb[0], tb[1], tb[2]) ||
            segment_intersects_triangle(b1, b2, ta[0], ta[1], ta[2]);
   }
-  // Disjoint vertex sets: reject when one triangle lies strictly on one side
-  // of the other's plane (Moller's early-out), else test every edge.
+  // Disjoint vertex sets: reject when the bounding boxes are apart or one
+  // triangle lies strictly on one side of the other's plane (Moller's
+  // early-out), else test every edge.
+  for (int k = 0; k < 3; ++k)
+    if (std::max({ta[0][k], ta[1][k], ta[2][k]}) < std::min({tb[0][k], tb[1][k], tb[2][k]}) ||
+        std::max({tb[0][k], tb[1][k], tb[2][k]}) < std::min({ta[0][k], ta[1][k], ta[2][k]}))
+      return false;
   auto one_side = [](const Vec3(&t)[3], const Vec3(&o)[3]) {
     const int s0 = orient3d(t[0], t[1], t[2], o[0]);
     const int s1 = orient3d(t[0], t[1], t[2], o[1]);
