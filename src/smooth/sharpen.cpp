@@ -28,7 +28,8 @@ using detail::degrees_between;
 using detail::Plane;
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr double kPi = std::numbers::pi;
-constexpr int kBucket = 4;       // cells per side of the buckets of the local intersection test
+constexpr int kBucket = 2;       // cells per side of the buckets of the local intersection test
+constexpr int kNearBlock = 4;    // cells per side of the blocks that decide which triangles it sees
 constexpr int kBisections = 8;   // steps when a move is cut back
 // A new vertex on a crease between two curved faces moves at most this far
 // (cells): their tangent planes are fitted, not detected, and on the
@@ -107,6 +108,8 @@ struct Sharpener {
   detail::RingScratch rings;                // scratch of rings_around (tangent_plane, thin_strips)
   std::vector<uint32_t> fan_off, fan;       // triangles around each vertex (CSR)
   std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;  // refined triangles by their first vertex's bucket
+  std::vector<Vec3> anchor;  // per refined triangle: its first vertex where index() bucketed it
+  double anchor_reach = 0;   // cells: farthest any triangle's vertex has been from its anchor (max norm)
   SharpenStats st;
 
   Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
@@ -926,8 +929,9 @@ struct Sharpener {
     return (uint64_t(b[0] + (1 << 20)) << 42) | (uint64_t(b[1] + (1 << 20)) << 21) | uint64_t(b[2] + (1 << 20));
   }
 
-  // Triangles around every vertex, and the buckets of
-  // refined triangles near the chamfers (for the local intersection test).
+  // Triangles around every vertex, and the buckets of refined triangles
+  // near the chamfers (for the local intersection test): those whose first
+  // vertex lies within a kNearBlock-cell block of a triangle with a new vertex.
   void index() {
     const size_t nvert = x.size();
     fan_off.assign(nvert + 1, 0);
@@ -938,20 +942,35 @@ struct Sharpener {
     std::vector<uint32_t> fill(fan_off.begin(), fan_off.end() - 1);
     for (uint32_t f = 0; f < tris.size(); ++f)
       for (uint32_t v : tris[f]) fan[fill[v]++] = f;
+    auto block_of = [](const Vec3& p) {
+      return std::array<int64_t, 3>{int64_t(std::floor(p.x() / kNearBlock)), int64_t(std::floor(p.y() / kNearBlock)),
+                                    int64_t(std::floor(p.z() / kNearBlock))};
+    };
     std::unordered_map<uint64_t, uint8_t> near;
     for (size_t f = 0; f < tris.size(); ++f) {
       bool touches_new = false;
       for (uint32_t v : tris[f]) touches_new |= v >= n;
       if (!touches_new) continue;
-      const auto b = bucket_of(x[tris[f][0]]);
+      const auto b = block_of(x[tris[f][0]]);
       for (int64_t dz = -1; dz <= 1; ++dz)
         for (int64_t dy = -1; dy <= 1; ++dy)
           for (int64_t dx = -1; dx <= 1; ++dx) near[bucket_key({b[0] + dx, b[1] + dy, b[2] + dz})] = 1;
     }
+    anchor.resize(tris.size());
+    anchor_reach = 0;
     for (uint32_t f = 0; f < tris.size(); ++f) {
-      const uint64_t k = bucket_key(bucket_of(x[tris[f][0]]));
-      if (near.count(k)) buckets[k].push_back(f);
+      anchor[f] = x[tris[f][0]];
+      if (!near.count(bucket_key(block_of(anchor[f])))) continue;
+      buckets[bucket_key(bucket_of(anchor[f]))].push_back(f);
+      for (uint32_t v : tris[f]) anchor_reach = std::max(anchor_reach, (x[v] - anchor[f]).cwiseAbs().maxCoeff());
     }
+  }
+
+  // After v moved: its triangles' vertices may now lie farther from their
+  // anchors, which widens every later search.
+  void widen(uint32_t v) {
+    for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k)
+      anchor_reach = std::max(anchor_reach, (x[v] - anchor[fan[k]]).cwiseAbs().maxCoeff());
   }
 
   // May vertex v move from x[v] to q? (Section 5 beyond the paper: the
@@ -987,7 +1006,8 @@ struct Sharpener {
         const uint32_t fi[3] = {t[0], t[1], t[2]}, ui[3] = {u[0], u[1], u[2]};
         if (detail::triangles_intersect(fb, fi, ub, ui)) return false;
       }
-    const auto b0 = bucket_of(lo - Vec3::Constant(kBucket)), b1 = bucket_of(hi + Vec3::Constant(kBucket));
+    // A triangle meeting the box [lo, hi] has its anchor within anchor_reach of it.
+    const auto b0 = bucket_of(lo - Vec3::Constant(anchor_reach)), b1 = bucket_of(hi + Vec3::Constant(anchor_reach));
     for (int64_t bz = b0[2]; bz <= b1[2]; ++bz)
       for (int64_t by = b0[1]; by <= b1[1]; ++by)
         for (int64_t bx = b0[0]; bx <= b1[0]; ++bx) {
@@ -1020,6 +1040,7 @@ struct Sharpener {
     if (q == p) return true;
     if (allowed(v, q)) {
       x[v] = q;
+      widen(v);
       return true;
     }
     if (!partial) return false;
@@ -1029,7 +1050,10 @@ struct Sharpener {
       const double mid = (lo + hi) / 2;
       (allowed(v, p + mid * (q - p)) ? lo : hi) = mid;
     }
-    if (lo > 0) x[v] = p + lo * (q - p);
+    if (lo > 0) {
+      x[v] = p + lo * (q - p);
+      widen(v);
+    }
     return false;
   }
 
