@@ -662,26 +662,28 @@ struct Detector {
       size_t count = 0;
       double c = 0;
     };
+    // Starts and ends sorted apart and merged, a start first at equal
+    // offsets; the best offset lies halfway to the next event.
     auto sweep = [&](const Vec3& d) {
-      std::vector<std::pair<double, int>> ev;
-      ev.reserve(2 * use.size());
+      std::vector<double> starts, ends;
+      starts.reserve(use.size());
+      ends.reserve(use.size());
       for (uint32_t q : use) {
         const double a = d.dot(S.inside(q)), b = d.dot(S.outside(q));
         if (!(b > a)) continue;
-        ev.push_back({a + o.margin * (b - a), 0});  // starts sort before ends at the same offset
-        ev.push_back({b - o.margin * (b - a), 1});
+        starts.push_back(a + o.margin * (b - a));
+        ends.push_back(b - o.margin * (b - a));
       }
-      std::sort(ev.begin(), ev.end());
+      std::sort(starts.begin(), starts.end());
+      std::sort(ends.begin(), ends.end());
       Best r;
-      size_t open = 0;
-      for (size_t i = 0; i < ev.size(); ++i) {
-        if (ev[i].second == 0) {
-          if (++open > r.count) {
-            r.count = open;
-            r.c = i + 1 < ev.size() ? 0.5 * (ev[i].first + ev[i + 1].first) : ev[i].first;
-          }
-        } else {
-          --open;
+      size_t i = 0, j = 0;
+      for (size_t open = 0; i < starts.size(); ++i) {
+        while (ends[j] < starts[i]) ++j, --open;  // every start has its end at or after it
+        if (++open > r.count) {
+          r.count = open;
+          const double next = i + 1 < starts.size() ? std::min(starts[i + 1], ends[j]) : ends[j];
+          r.c = 0.5 * (starts[i] + next);
         }
       }
       return r;
