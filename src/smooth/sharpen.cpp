@@ -108,7 +108,9 @@ struct Sharpener {
   detail::RingScratch rings;                // scratch of rings_around (tangent_plane, thin_strips)
   std::vector<uint32_t> fan_off, fan;       // triangles around each vertex (CSR)
   std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;  // refined triangles by their first vertex's bucket
-  std::vector<Vec3> anchor;  // per refined triangle: its first vertex where index() bucketed it
+  // Per refined triangle: its first vertex where index() bucketed it (float:
+  // the bucket and the reach below both use this rounded point).
+  std::vector<Eigen::Vector3f> anchor;
   double anchor_reach = 0;   // cells: farthest any triangle's vertex has been from its anchor (max norm)
   SharpenStats st;
 
@@ -959,10 +961,11 @@ struct Sharpener {
     anchor.resize(tris.size());
     anchor_reach = 0;
     for (uint32_t f = 0; f < tris.size(); ++f) {
-      anchor[f] = x[tris[f][0]];
-      if (!near.count(bucket_key(block_of(anchor[f])))) continue;
-      buckets[bucket_key(bucket_of(anchor[f]))].push_back(f);
-      for (uint32_t v : tris[f]) anchor_reach = std::max(anchor_reach, (x[v] - anchor[f]).cwiseAbs().maxCoeff());
+      anchor[f] = x[tris[f][0]].cast<float>();
+      const Vec3 a = anchor[f].cast<double>();
+      if (!near.count(bucket_key(block_of(a)))) continue;
+      buckets[bucket_key(bucket_of(a))].push_back(f);
+      for (uint32_t v : tris[f]) anchor_reach = std::max(anchor_reach, (x[v] - a).cwiseAbs().maxCoeff());
     }
   }
 
@@ -970,7 +973,7 @@ struct Sharpener {
   // anchors, which widens every later search.
   void widen(uint32_t v) {
     for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k)
-      anchor_reach = std::max(anchor_reach, (x[v] - anchor[fan[k]]).cwiseAbs().maxCoeff());
+      anchor_reach = std::max(anchor_reach, (x[v] - anchor[fan[k]].cast<double>()).cwiseAbs().maxCoeff());
   }
 
   // May vertex v move from x[v] to q? (Section 5 beyond the paper: the
