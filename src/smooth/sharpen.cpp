@@ -1009,8 +1009,10 @@ struct Sharpener {
         const uint32_t fi[3] = {t[0], t[1], t[2]}, ui[3] = {u[0], u[1], u[2]};
         if (detail::triangles_intersect(fb, fi, ub, ui)) return false;
       }
-    // A triangle meeting the box [lo, hi] has its anchor within anchor_reach of it.
-    const auto b0 = bucket_of(lo - Vec3::Constant(anchor_reach)), b1 = bucket_of(hi + Vec3::Constant(anchor_reach));
+    // A triangle meeting the box [lo, hi] has its anchor within anchor_reach
+    // of it (plus a hair for the rounding of the differences).
+    const Vec3 pad = Vec3::Constant(anchor_reach + 1e-6);
+    const auto b0 = bucket_of(lo - pad), b1 = bucket_of(hi + pad);
     for (int64_t bz = b0[2]; bz <= b1[2]; ++bz)
       for (int64_t by = b0[1]; by <= b1[1]; ++by)
         for (int64_t bx = b0[0]; bx <= b1[0]; ++bx) {
