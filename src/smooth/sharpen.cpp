@@ -46,7 +46,6 @@ constexpr uint8_t kRimStrip = 3;  // in a strip's pocket next to a curved face (
 
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
 
-
 // Is z in the closed tetrahedron (a, b, c, d)? A flat tetrahedron counts z
 // when z is coplanar with it (conservative).
 bool in_closed_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z) {
@@ -924,8 +923,9 @@ struct Sharpener {
     st.inserted = nv.size() - st.corners;
   }
 
-  std::array<int64_t, 3> bucket_of(const Vec3& p) const {
-    return {int64_t(std::floor(p.x() / kBucket)), int64_t(std::floor(p.y() / kBucket)), int64_t(std::floor(p.z() / kBucket))};
+  // The cell of a grid of `side`-cell cubes that holds p.
+  static std::array<int64_t, 3> grid_cell(const Vec3& p, int side) {
+    return {int64_t(std::floor(p.x() / side)), int64_t(std::floor(p.y() / side)), int64_t(std::floor(p.z() / side))};
   }
   static uint64_t bucket_key(const std::array<int64_t, 3>& b) {
     return (uint64_t(b[0] + (1 << 20)) << 42) | (uint64_t(b[1] + (1 << 20)) << 21) | uint64_t(b[2] + (1 << 20));
@@ -944,16 +944,12 @@ struct Sharpener {
     std::vector<uint32_t> fill(fan_off.begin(), fan_off.end() - 1);
     for (uint32_t f = 0; f < tris.size(); ++f)
       for (uint32_t v : tris[f]) fan[fill[v]++] = f;
-    auto block_of = [](const Vec3& p) {
-      return std::array<int64_t, 3>{int64_t(std::floor(p.x() / kNearBlock)), int64_t(std::floor(p.y() / kNearBlock)),
-                                    int64_t(std::floor(p.z() / kNearBlock))};
-    };
     std::unordered_map<uint64_t, uint8_t> near;
     for (size_t f = 0; f < tris.size(); ++f) {
       bool touches_new = false;
       for (uint32_t v : tris[f]) touches_new |= v >= n;
       if (!touches_new) continue;
-      const auto b = block_of(x[tris[f][0]]);
+      const auto b = grid_cell(x[tris[f][0]], kNearBlock);
       for (int64_t dz = -1; dz <= 1; ++dz)
         for (int64_t dy = -1; dy <= 1; ++dy)
           for (int64_t dx = -1; dx <= 1; ++dx) near[bucket_key({b[0] + dx, b[1] + dy, b[2] + dz})] = 1;
@@ -963,8 +959,8 @@ struct Sharpener {
     for (uint32_t f = 0; f < tris.size(); ++f) {
       anchor[f] = x[tris[f][0]].cast<float>();
       const Vec3 a = anchor[f].cast<double>();
-      if (!near.count(bucket_key(block_of(a)))) continue;
-      buckets[bucket_key(bucket_of(a))].push_back(f);
+      if (!near.count(bucket_key(grid_cell(a, kNearBlock)))) continue;
+      buckets[bucket_key(grid_cell(a, kBucket))].push_back(f);
       for (uint32_t v : tris[f]) anchor_reach = std::max(anchor_reach, (x[v] - a).cwiseAbs().maxCoeff());
     }
   }
@@ -1012,7 +1008,7 @@ struct Sharpener {
     // A triangle meeting the box [lo, hi] has its anchor within anchor_reach
     // of it (plus a hair for the rounding of the differences).
     const Vec3 pad = Vec3::Constant(anchor_reach + 1e-6);
-    const auto b0 = bucket_of(lo - pad), b1 = bucket_of(hi + pad);
+    const auto b0 = grid_cell(lo - pad, kBucket), b1 = grid_cell(hi + pad, kBucket);
     for (int64_t bz = b0[2]; bz <= b1[2]; ++bz)
       for (int64_t by = b0[1]; by <= b1[1]; ++by)
         for (int64_t bx = b0[0]; bx <= b1[0]; ++bx) {
