@@ -148,12 +148,13 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
     else if (k == "sharp_angle") o.sharp.sharp_angle = value.cast<double>();
     else if (k == "wall_thickness") o.sharp.wall_thickness = value.cast<double>();
     else if (k == "color_regions") o.color_regions = value.cast<bool>();
+    else if (k == "fit_rings") o.fit.rings = value.cast<int>();
     else if (k == "lambda_") o.overrides.lambda = value.cast<double>();
     else if (k == "mu") o.overrides.mu = value.cast<double>();
     else
       throw py::type_error("press() got an unknown option '" + k +
                            "' (iterations, tolerance, flats, sharpen, min_flat_area, junction_angle, sharp_angle, "
-                           "wall_thickness, color_regions, lambda_, mu)");
+                           "wall_thickness, color_regions, fit_rings, lambda_, mu)");
   }
 }
 

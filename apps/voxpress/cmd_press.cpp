@@ -13,6 +13,7 @@ struct PressCmd {
   PressCli smooth;
   FlatOptions flats;
   SharpenOptions sharpen;
+  QuadricFitOptions fit;
   std::string features;
   bool no_flats = false, no_sharpen = false, no_curved_creases = false, color_regions = false;
   bool ascii = false, check = false;
@@ -96,7 +97,7 @@ void run_press(const PressCmd& c, const Global& g) {
          {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend", "--flat-width",
           "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations", "--wall-thickness", "--features",
           "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain",
-          "--fixed-ends", "--no-curved-creases"})
+          "--fixed-ends", "--no-curved-creases", "--fit-rings"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
   if (!c.features.empty()) {
     const MeshFormat ff = mesh_format_from_path(c.features);
@@ -112,6 +113,7 @@ void run_press(const PressCmd& c, const Global& g) {
   so.flats = !c.no_flats;
   so.flat = c.flats;
   so.flat.curved_creases = !c.no_curved_creases;
+  so.fit = c.fit;
   so.sharpen = !c.no_sharpen;
   so.sharp = c.sharpen;
   so.sharp.curved_creases = !c.no_curved_creases;
@@ -157,9 +159,10 @@ void run_press(const PressCmd& c, const Global& g) {
     if (pressing) {
       j["pressing"] = press_stats_json(r.press, so.press);
       if (so.flats) j["flats"] = flats_json(r.flats, so.flat);
+      j["quadric_fit"] = {{"rings", so.fit.rings}, {"fitted", r.fit.fitted}, {"moved", r.fit.moved}};
       if (so.flats && so.sharpen) j["sharpen"] = sharpen_json(r.sharpen, so.sharp);
       j["seconds"] = {{"read", seconds_read}, {"extract", r.seconds_extract}, {"press", r.press.seconds},
-                      {"sharpen", r.sharpen.seconds}, {"total", clock.seconds()}};
+                      {"quadric_fit", r.fit.seconds}, {"sharpen", r.sharpen.seconds}, {"total", clock.seconds()}};
     } else {
       if (so.method == Method::cesn)
         j["smoothing"] = {{"iterations", r.net.iterations},      {"converged", r.net.converged},
@@ -193,6 +196,11 @@ void register_press(CLI::App& app, Global& g) {
       ->capture_default_str();
   c->in.bind(*cmd);
   c->smooth.bind(*cmd);
+  cmd->add_option("--fit-rings", c->fit.rings,
+                  "After pressing, move each curved vertex onto the quadric fitted to the curved vertices within this "
+                  "many rings, when it fits (0: off)")
+      ->check(CLI::Range(0, 12))
+      ->capture_default_str();
   bind_fairing(*cmd->add_option_group("fairing", "Taubin / Laplacian (--method taubin|laplacian)"), c->overrides);
   auto* f = cmd->add_option_group("flats", "Flats (plane voting) and junctions");
   f->add_flag("--no-flats", c->no_flats, "Do not look for flats: every vertex is smoothed");

@@ -19,7 +19,6 @@ namespace voxpress {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr int kStabSolves = 20;     // Quadric::stab's least-squares solves
 constexpr size_t kSidePoints = 12;  // fewest points of a curved crease's side (Quadric::fit's minimum)
 
 }  // namespace

@@ -83,6 +83,9 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
       ov.apply(po);
       const SliceCurves curves = build_slice_curves(surface);
       r.press = press_with_flats(surface, curves, po, o.flats ? &fo : nullptr, &r.flats).press;
+      QuadricFitOptions qo = o.fit;
+      qo.margin = po.margin;
+      r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
       if (o.flats && o.sharpen) {
         SharpenOptions so = o.sharp;
         so.colors = o.color_regions;

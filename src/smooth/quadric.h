@@ -13,6 +13,8 @@
 
 namespace voxpress::detail {
 
+constexpr int kStabSolves = 20;  // Quadric::stab's least-squares solves (its callers' `iters`)
+
 // z = h(a, b) = q0 a^2 + q1 a b + q2 b^2 + q3 a + q4 b + q5 over the frame
 // (m; u, w, n) of the points' PCA, n outward (the solid is below: z < h).
 struct Quadric {
@@ -66,25 +68,29 @@ struct Quadric {
       N0 += r * r.transpose();
       r0 += z * r;
     }
+    // Each sample's design row and height, once (2k: inside, 2k + 1: outside).
+    std::vector<Eigen::Matrix<double, 6, 1>> rs(2 * ins.size());
+    std::vector<double> zs(2 * ins.size());
+    for (size_t k = 0; k < ins.size(); ++k) {
+      zs[2 * k] = row(ins[k], rs[2 * k]);
+      zs[2 * k + 1] = row(outs[k], rs[2 * k + 1]);
+    }
     std::vector<uint8_t> active(2 * ins.size(), 0);
     for (int it = 0; it < iters; ++it) {
       bool changed = false;
       for (size_t k = 0; k < ins.size(); ++k) {
-        double z = row(ins[k], r);
-        if (z - r.dot(q) > -eps && !active[2 * k]) active[2 * k] = 1, changed = true;
-        z = row(outs[k], r);
-        if (z - r.dot(q) < eps && !active[2 * k + 1]) active[2 * k + 1] = 1, changed = true;
+        if (!active[2 * k] && zs[2 * k] - rs[2 * k].dot(q) > -eps) active[2 * k] = 1, changed = true;
+        if (!active[2 * k + 1] && zs[2 * k + 1] - rs[2 * k + 1].dot(q) < eps) active[2 * k + 1] = 1, changed = true;
       }
       if (!changed) break;
       Eigen::Matrix<double, 6, 6> N = N0;
       Eigen::Matrix<double, 6, 1> rhs = r0;
-      for (size_t k = 0; k < ins.size(); ++k)
-        for (int e = 0; e < 2; ++e) {
-          if (!active[2 * k + size_t(e)]) continue;
-          const double z = row(e ? outs[k] : ins[k], r) + (e ? -eps : eps);
-          N += weight * r * r.transpose();
-          rhs += weight * z * r;
-        }
+      for (size_t k = 0; k < 2 * ins.size(); ++k) {
+        if (!active[k]) continue;
+        const double z = zs[k] + (k % 2 ? -eps : eps);
+        N += weight * rs[k] * rs[k].transpose();
+        rhs += weight * z * rs[k];
+      }
       q = N.ldlt().solve(rhs);
     }
     double ss = 0;

@@ -43,6 +43,13 @@ TEST(Pipeline, PressingStagesAndOverridesAreHonoured) {
   const SurfaceResult chamfered = smooth_surface(box.volume, o);
   EXPECT_TRUE(chamfered.mesh.edges.empty());
   EXPECT_EQ(chamfered.mesh.vertex_count(), chamfered.extract.sticks);
+  // The quadric fit after pressing moves only curved vertices (a box's
+  // chamfers here), and not at all when off.
+  EXPECT_GT(chamfered.fit.moved, 0u);
+  EXPECT_LE(chamfered.fit.moved, chamfered.fit.fitted);
+  EXPECT_LE(chamfered.fit.fitted, chamfered.extract.sticks - chamfered.flats.frozen_count());
+  o.fit.rings = 0;
+  EXPECT_EQ(smooth_surface(box.volume, o).fit.fitted, 0u);
   o.flats = false;
   o.overrides.iterations = 3;
   const SurfaceResult plain = smooth_surface(box.volume, o);

@@ -55,6 +55,7 @@ struct SurfaceOptions {
   PressOptions press;
   bool flats = true;         ///< find flats and junctions (Section 3)
   FlatOptions flat;
+  QuadricFitOptions fit;     ///< the local quadric fit after pressing (fit.rings = 0: none); margin from press
   bool sharpen = true;       ///< insert the sharp edges (Section 5; needs flats)
   SharpenOptions sharp;
   bool color_regions = false;  ///< vertex colours per region
@@ -73,6 +74,7 @@ struct SurfaceResult {
   // pressing
   PressStats press;
   FlatSegmentation flats;      ///< empty without flats
+  QuadricFitStats fit;
   SharpenStats sharpen;
   // the other methods
   SmoothStats smooth;          ///< diamond, cell-edge, cell-size, taubin, laplacian

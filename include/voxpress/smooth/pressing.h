@@ -99,6 +99,35 @@ PressStats press(StickSurface& surface, const SliceCurves& curves, const PressOp
 /// Convenience: builds the curves and presses.
 PressStats press(StickSurface& surface, const PressOptions& options = {});
 
+/// Beyond the paper: a local quadric fit after pressing. The bilaplacian's
+/// fixed points are not circles, so tight curves stay pressed towards the
+/// inner ends of their sticks (a cylinder of radius 4 cells at 128^3: 0.03
+/// voxel inwards, 0.066 RMS). Each fresh vertex (`region` < 0 and no
+/// `junction` flag; empty vectors: every vertex) gets the quadric height
+/// field of the fresh vertices within `rings` rings of it, trusted when its
+/// RMS residual is at most `residual` cells, refitted so that each of those
+/// vertices' stick samples lies at least `stab_eps` cells on its side
+/// (inside below, outside above), and moves to where its stick leaves the
+/// quadric's solid, t kept in [margin, 1 - margin] (so, as in pressing, no
+/// sample changes side). All vertices are fitted from the pressed positions
+/// (Jacobi: the result does not depend on the order or the thread count).
+/// Measured choices: docs/ARCHITECTURE.md (Pressing, local quadric fit).
+struct QuadricFitOptions {
+  int rings = 5;            ///< the fit's neighbourhood (0: no fit)
+  double residual = 0.08;   ///< cells: largest RMS residual of a trusted fit
+  double stab_eps = 0.03;   ///< cells: how far each stick sample stays on its side of the fit
+  double margin = 0.01;     ///< t kept in [margin, 1 - margin]
+};
+
+struct QuadricFitStats {
+  size_t fitted = 0;  ///< vertices whose fit was trusted
+  size_t moved = 0;   ///< of those, vertices that moved
+  double seconds = 0;
+};
+
+QuadricFitStats fit_local_quadrics(StickSurface& surface, const std::vector<int32_t>& region,
+                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& options = {});
+
 // ----------------------------------------------------------------- 2D
 /// A binary image's contours, pressed: the 2D counterpart, through the same
 /// curve kernel. Pixels are samples at integer (x, y), y down; outside the

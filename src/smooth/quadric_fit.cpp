@@ -1,0 +1,78 @@
+// Beyond the paper: the local quadric fit after pressing. Theory of
+// operation: include/voxpress/smooth/pressing.h (fit_local_quadrics).
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "quadric.h"
+#include "surface_graph.h"
+#include "voxpress/smooth/pressing.h"
+
+namespace voxpress {
+
+namespace {
+
+constexpr double kStabWeight = 100;  // Quadric::stab's weight, as for the curved creases
+
+struct FitScratch {
+  detail::RingScratch rings;
+  std::vector<Vec3> pts, ins, outs;
+};
+
+}  // namespace
+
+QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& region,
+                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t n = s.stick_count();
+  if (!region.empty() && region.size() != n) throw std::invalid_argument("fit_local_quadrics: regions do not match the sticks");
+  if (!junction.empty() && junction.size() != n)
+    throw std::invalid_argument("fit_local_quadrics: junction flags do not match the sticks");
+  QuadricFitStats st;
+  if (o.rings <= 0 || n == 0) return st;
+  const auto fresh = [&](size_t v) { return (region.empty() || region[v] < 0) && (junction.empty() || !junction[v]); };
+  std::vector<uint32_t> off, adj;
+  detail::vertex_adjacency(n, s.triangles, off, adj);
+  std::vector<Vec3> x(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
+  // New t per vertex (from the lower sample, as StickSurface::t), NaN: unchanged.
+  std::vector<double> next(n, std::numeric_limits<double>::quiet_NaN());
+  tbb::enumerable_thread_specific<FitScratch> scratch;
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    if (!fresh(v)) return;
+    FitScratch& f = scratch.local();
+    detail::rings_around(uint32_t(v), uint32_t(o.rings), off, adj, [&](uint32_t w) { return fresh(w); }, f.rings);
+    f.pts.clear();
+    f.ins.clear();
+    f.outs.clear();
+    Vec3 outward = Vec3::Zero();
+    for (const auto& [w, ring] : f.rings.out) {
+      f.pts.push_back(x[w]);
+      f.ins.push_back(s.inside_sample(w));
+      f.outs.push_back(s.outside_sample(w));
+      outward[s.axis(w)] += s.lower_inside(w) ? 1 : -1;
+    }
+    detail::Quadric q;
+    if (!q.fit(f.pts, outward) || q.residual > o.residual) return;
+    q.stab(f.pts, f.ins, f.outs, o.stab_eps, kStabWeight, detail::kStabSolves);
+    const bool lower_in = s.lower_inside(v);
+    const double now = lower_in ? s.t[v] : 1 - s.t[v];  // from the inside sample
+    const double t = q.exit(s.inside_sample(v), s.outside_sample(v), now, o.margin, 1 - o.margin);
+    next[v] = std::isnan(t) ? -1.0 : lower_in ? t : 1 - t;  // -1: fitted, not crossed within the margins
+  });
+  for (size_t v = 0; v < n; ++v) {
+    if (std::isnan(next[v])) continue;
+    ++st.fitted;
+    if (next[v] < 0 || next[v] == s.t[v]) continue;
+    s.t[v] = next[v];
+    ++st.moved;
+  }
+  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return st;
+}
+
+}  // namespace voxpress
