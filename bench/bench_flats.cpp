@@ -50,6 +50,11 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
   po.iterations = iterations;
   FlatSegmentation seg;
   const FeaturePressStats st = press_with_flats(s, curves, po, &fo, &seg);
+  // "+ smoothing" is what `voxpress press` hands to sharpening: Pressing with
+  // the flats, then the local quadric fit.
+  QuadricFitOptions qo;
+  qo.margin = po.margin;
+  fit_local_quadrics(s, seg.region, seg.junction, qo);
   StickSurface tiles = s;
   apply_flats(tiles, seg);
   const double with_tiles = stick_rms(tiles, *c.truth, c.volume);

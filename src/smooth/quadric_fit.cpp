@@ -16,7 +16,12 @@ namespace voxpress {
 
 namespace {
 
-constexpr double kStabWeight = 100;  // Quadric::stab's weight, as for the curved creases
+// Quadric::stab's weight. The curved creases use 100; here each vertex has
+// its own fit, and at 100 the active sets' jumps between neighbouring fits
+// roughen the surface (sphere 128 normal error 0.47 -> 0.75 degrees); 10
+// keeps most of the gain (fandisk 128 seeds 1-4 r->t 0.0590 -> 0.0556,
+// normal error 2.69 -> 2.68 degrees; sphere 0.0328 -> 0.0317, 0.57 degrees).
+constexpr double kStabWeight = 10;
 
 struct FitScratch {
   detail::RingScratch rings;
