@@ -78,7 +78,9 @@ TEST(Pressing, QuadricFitKeepsEveryGuaranteeOnThePropertyCorpus) {
       moved += fit_local_quadrics(s, {}, junction).moved;
       for (size_t i = 0; i < s.t.size(); ++i) {
         ASSERT_TRUE(s.t[i] >= o.margin && s.t[i] <= 1 - o.margin);
-        if (!junction.empty() && junction[i]) ASSERT_EQ(s.t[i], before[i]) << "a junction vertex moved";
+        if (!junction.empty() && junction[i]) {
+          ASSERT_EQ(s.t[i], before[i]) << "a junction vertex moved";
+        }
       }
       const Mesh m = to_mesh(s);
       const MeshCheck r = check_mesh(m);
