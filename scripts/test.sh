@@ -28,7 +28,7 @@ Flats.CadPartPlanarFacesFoundNoneSpurious:Flats.CadPartAt256FoundNoneSpurious:Fl
 Flats.RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats:Flats.OrganicShapesHaveNoFlats:Flats.FlatsMakeTheBoxMoreAccurate:\
 Flats.FilletTangentToAFlatIsNotAJunction:Flats.CreaseRefitPinsFacesAlongALatticeAxis:Sharpen.RimPocketsLeaveTheCurvedCreasesInPlace:\
 Sharpen.FreeEndsKeepTheCurvedSideOffTheFlatsCorner:Sharpen.CurvedCreasesArePlacedAndLabelled:\
-Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Metrics.MidpointRowOfThePaperIsReproduced:\
+Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Pressing.QuadricFitBringsTightCurvesCloserToTheTruth:Metrics.MidpointRowOfThePaperIsReproduced:\
 Shapes.CadPartMeshIsAValidSolidMatchingItsClosedFormVolume"
 # smooth_tests, the longest, runs as two shards.
 runs=(smooth_tests:0:2 smooth_tests:1:2)
