@@ -3,6 +3,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -42,8 +43,16 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
   const auto fresh = [&](size_t v) { return (region.empty() || region[v] < 0) && (junction.empty() || !junction[v]); };
   std::vector<uint32_t> off, adj;
   detail::vertex_adjacency(n, s.triangles, off, adj);
+  // Per vertex, once (every fit reads ~90 neighbours): its position and its
+  // stick's inside and outside samples (lattice points: exact in float).
   std::vector<Vec3> x(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
+  std::vector<std::array<Eigen::Vector3f, 2>> samples(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    x[v] = s.index_position(v);
+    samples[v] = {s.inside_sample(v).cast<float>(), s.outside_sample(v).cast<float>()};
+  });
+  const auto inside = [&](size_t v) { return Vec3(samples[v][0].cast<double>()); };
+  const auto outside = [&](size_t v) { return Vec3(samples[v][1].cast<double>()); };
   // New t per vertex (from the lower sample, as StickSurface::t), NaN: unchanged.
   std::vector<double> next(n, std::numeric_limits<double>::quiet_NaN());
   tbb::enumerable_thread_specific<FitScratch> scratch;
@@ -57,8 +66,8 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     Vec3 outward = Vec3::Zero();
     for (const auto& [w, ring] : f.rings.out) {
       f.pts.push_back(x[w]);
-      f.ins.push_back(s.inside_sample(w));
-      f.outs.push_back(s.outside_sample(w));
+      f.ins.push_back(inside(w));
+      f.outs.push_back(outside(w));
       outward[s.axis(w)] += s.lower_inside(w) ? 1 : -1;
     }
     detail::Quadric q;
@@ -66,7 +75,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     q.stab(f.pts, f.ins, f.outs, o.stab_eps, kStabWeight, detail::kStabSolves);
     const bool lower_in = s.lower_inside(v);
     const double now = lower_in ? s.t[v] : 1 - s.t[v];  // from the inside sample
-    const double t = q.exit(s.inside_sample(v), s.outside_sample(v), now, o.margin, 1 - o.margin);
+    const double t = q.exit(inside(v), outside(v), now, o.margin, 1 - o.margin);
     next[v] = std::isnan(t) ? -1.0 : lower_in ? t : 1 - t;  // -1: fitted, not crossed within the margins
   });
   for (size_t v = 0; v < n; ++v) {
