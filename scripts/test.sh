@@ -18,7 +18,7 @@ cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCM
 cmake --build "$root/build-asan" -j "$(nproc)" --target "${suites[@]}" >&2
 # Each suite's executable directly (the CLI, Python and browser tests ran in
 # Release above), two at a time; any sanitizer report fails the suite. Left
-# out: the fidelity checks at 64-128^3 (10-80 s each under ASan), which run
+# out: the fidelity checks at 64-128^3 (10-160 s each under ASan), which run
 # the very code the property corpus runs, on bigger volumes; they passed in
 # Release above.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -28,6 +28,8 @@ Flats.CadPartPlanarFacesFoundNoneSpurious:Flats.CadPartAt256FoundNoneSpurious:Fl
 Flats.RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats:Flats.OrganicShapesHaveNoFlats:Flats.FlatsMakeTheBoxMoreAccurate:\
 Flats.FilletTangentToAFlatIsNotAJunction:Flats.CreaseRefitPinsFacesAlongALatticeAxis:Sharpen.RimPocketsLeaveTheCurvedCreasesInPlace:\
 Sharpen.FreeEndsKeepTheCurvedSideOffTheFlatsCorner:Sharpen.CurvedCreasesArePlacedAndLabelled:\
+Sharpen.FinalCreaseFitPlacesTheRoundedCreases:Sharpen.SnappingTakesBevelsNotCurvedFaces:Sharpen.FandiskGetsMoreAccurate:\
+Flats.FacesNearALatticeAxisAreFound:Flats.CentredPlanesAreCloserToTheFaces:\
 Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Pressing.QuadricFitBringsTightCurvesCloserToTheTruth:Metrics.MidpointRowOfThePaperIsReproduced:\
 Shapes.CadPartMeshIsAValidSolidMatchingItsClosedFormVolume"
 # smooth_tests, the longest, runs as two shards.

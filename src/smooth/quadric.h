@@ -22,14 +22,20 @@ struct Quadric {
   Eigen::Matrix<double, 6, 1> q;
   double residual = 0;  // RMS distance along n of the points to the fit
 
+  // The frame from its origin and unit normal (u and w follow from n, so a
+  // quadric is stored as m, n and q).
+  void set_frame(const Vec3& origin, const Vec3& normal) {
+    m = origin;
+    n = normal;
+    u = n.cross(std::abs(n.x()) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)).normalized();
+    w = n.cross(u);
+  }
+
   // False with fewer than 12 points or a rank-deficient design (a curve).
   bool fit(const std::vector<Vec3>& pts, const Vec3& outward) {
     if (pts.size() < 12) return false;
     const Pca p = pca(pts);
-    m = p.mean;
-    n = p.normal.dot(outward) < 0 ? Vec3(-p.normal) : p.normal;
-    u = n.cross(std::abs(n.x()) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)).normalized();
-    w = n.cross(u);
+    set_frame(p.mean, p.normal.dot(outward) < 0 ? Vec3(-p.normal) : p.normal);
     Eigen::MatrixXd A(pts.size(), 6);
     Eigen::VectorXd z(pts.size());
     for (size_t k = 0; k < pts.size(); ++k) {

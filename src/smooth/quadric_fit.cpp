@@ -24,6 +24,12 @@ namespace {
 // normal error 2.69 -> 2.68 degrees; sphere 0.0328 -> 0.0317, 0.57 degrees).
 constexpr double kStabWeight = 10;
 
+// A trusted fit, stored compactly (u and w follow from n).
+struct StoredQuadric {
+  Vec3 m, n;
+  Eigen::Matrix<double, 6, 1> q;
+};
+
 struct FitScratch {
   detail::RingScratch rings;
   std::vector<Vec3> pts, ins, outs;
@@ -53,8 +59,9 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
   });
   const auto inside = [&](size_t v) { return Vec3(samples[v][0].cast<double>()); };
   const auto outside = [&](size_t v) { return Vec3(samples[v][1].cast<double>()); };
-  // New t per vertex (from the lower sample, as StickSurface::t), NaN: unchanged.
-  std::vector<double> next(n, std::numeric_limits<double>::quiet_NaN());
+  // Each fresh vertex's quadric, when trusted (`fitted`).
+  std::vector<StoredQuadric> quad(n);
+  std::vector<uint8_t> fitted(n, 0);
   tbb::enumerable_thread_specific<FitScratch> scratch;
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
     if (!fresh(v)) return;
@@ -73,10 +80,43 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     detail::Quadric q;
     if (!q.fit(f.pts, outward) || q.residual > o.residual) return;
     q.stab(f.pts, f.ins, f.outs, o.stab_eps, kStabWeight, detail::kStabSolves);
+    quad[v] = {q.m, q.n, q.q};
+    fitted[v] = 1;
+  });
+  // New t per vertex (from the lower sample, as StickSurface::t), NaN:
+  // unchanged. Each fitted vertex moves to the mean of the exits of its
+  // stick from its own quadric and from its fitted neighbours' (the one
+  // nearest its own exit): neighbouring fits differ by their active sets and
+  // their windows, and the mean blends them as a partition of unity would
+  // (sphere 128 normal error 0.57 -> 0.53 degrees, r->t 0.0318 -> 0.0316;
+  // two rings 0.51 degrees; fandisk unchanged).
+  std::vector<double> next(n, std::numeric_limits<double>::quiet_NaN());
+  const auto quadric = [&](size_t v) {
+    detail::Quadric q;
+    q.set_frame(quad[v].m, quad[v].n);
+    q.q = quad[v].q;
+    return q;
+  };
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    if (!fitted[v]) return;
     const bool lower_in = s.lower_inside(v);
-    const double now = lower_in ? s.t[v] : 1 - s.t[v];  // from the inside sample
-    const double t = q.exit(inside(v), outside(v), now, o.margin, 1 - o.margin);
-    next[v] = std::isnan(t) ? -1.0 : lower_in ? t : 1 - t;  // -1: fitted, not crossed within the margins
+    const Vec3 in = inside(v), out = outside(v);
+    const double own = quadric(v).exit(in, out, lower_in ? s.t[v] : 1 - s.t[v], o.margin, 1 - o.margin);
+    if (std::isnan(own)) {
+      next[v] = -1;  // fitted, not crossed within the margins
+      return;
+    }
+    double sum = own, count = 1;
+    for (uint32_t k = off[v]; k < off[v + 1]; ++k) {
+      const uint32_t w = adj[k];
+      if (!fitted[w]) continue;
+      const double t = quadric(w).exit(in, out, own, o.margin, 1 - o.margin);
+      if (std::isnan(t)) continue;
+      sum += t;
+      count += 1;
+    }
+    const double t = sum / count;  // within the margins: a mean of values there
+    next[v] = lower_in ? t : 1 - t;
   });
   for (size_t v = 0; v < n; ++v) {
     if (std::isnan(next[v])) continue;

@@ -107,9 +107,10 @@ PressStats press(StickSurface& surface, const PressOptions& options = {});
 /// field of the fresh vertices within `rings` rings of it, trusted when its
 /// RMS residual is at most `residual` cells, refitted so that each of those
 /// vertices' stick samples lies at least `stab_eps` cells on its side
-/// (inside below, outside above), and moves to where its stick leaves the
-/// quadric's solid, t kept in [margin, 1 - margin] (so, as in pressing, no
-/// sample changes side). All vertices are fitted from the pressed positions
+/// (inside below, outside above), and moves to the mean of where its stick
+/// leaves the solids of its own quadric and of its fitted neighbours', t
+/// kept in [margin, 1 - margin] (so, as in pressing, no sample changes
+/// side). All vertices are fitted from the pressed positions
 /// (Jacobi: the result does not depend on the order or the thread count).
 /// Measured choices: docs/ARCHITECTURE.md (Pressing, local quadric fit).
 struct QuadricFitOptions {
