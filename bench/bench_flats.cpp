@@ -181,7 +181,7 @@ void run(const Case& c, const FlatOptions& fo, int iterations, bool header, bool
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{"voxpress flats benchmark"};
   std::string shape, model;
   int64_t res = 0;
@@ -275,4 +275,7 @@ int main(int argc, char** argv) {
       header = false;
     }
   return 0;
+} catch (const std::exception& e) {  // a missing or unreadable --model: one line, no abort
+  std::fprintf(stderr, "bench_flats: %s\n", e.what());
+  return 1;
 }

@@ -96,7 +96,7 @@ void run_press(const PressCmd& c, const Global& g) {
     for (const char* name :
          {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend", "--flat-width",
           "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations", "--wall-thickness", "--features",
-          "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain",
+          "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain", "--circle-correction",
           "--fixed-ends", "--no-curved-creases", "--fit-rings"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
   if (!c.features.empty()) {

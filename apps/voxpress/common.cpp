@@ -156,6 +156,9 @@ void PressCli::bind(CLI::App& cmd, bool barriers) {
   g->add_option("--weighting", weighting, "equal | normal | tangent (combining a stick's two proposals)")
       ->capture_default_str();
   g->add_flag("--plain", plain, "Bilaplacian of the actual neighbours, no arc-length resampling (paper Fig. 5)");
+  g->add_option("--circle-correction", options.circle_correction,
+                "Degrees: largest chord turning angle whose circle shrinkage is cancelled (0: the paper's bilaplacian)")
+      ->capture_default_str();
   if (barriers)
     g->add_flag("--fixed-ends", fixed_ends,
                 "Curve pieces next to a sharp flat border keep the flat's last vertex as a fixed end (default: free "
@@ -173,6 +176,7 @@ PressOptions PressCli::resolve() const {
   else
     throw UsageError("--weighting must be equal, normal or tangent");
   o.resample = !plain;
+  if (!(o.circle_correction >= 0 && o.circle_correction <= 45)) throw UsageError("--circle-correction must be in [0, 45]");
   o.free_ends = !fixed_ends;
   if (o.iterations < 0) throw UsageError("--iterations must be >= 0");
   if (!(o.margin > 0 && o.margin < 0.5)) throw UsageError("--margin must be in (0, 0.5)");

@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <numbers>
 #include <stdexcept>
 
 #include "core/timing.h"
@@ -88,8 +89,8 @@ struct Scratch {
 // (closed, or open with fixed or free ends), in the plane's index coordinates, and
 // unit tangents (index coordinates, unit in the metric) for the weightings.
 // Section 4, Fig. 4-6: virtual neighbours at arc length d, two Laplacian passes.
-void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool tangents, const Metric& g,
-                Scratch& w, bool free_ends = false) {
+void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool tangents, double correction,
+                const Metric& g, Scratch& w, bool free_ends = false) {
   const Vec2* p = w.pos.data();
   double* len = w.len.data();
   Where* fwd = w.fwd.data();
@@ -184,7 +185,24 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
   const auto lap_at = [&](const Where& x) {
     return x.mirror != 0 ? Vec2(Vec2::Zero()) : Vec2(lap[x.k] + x.f * (lap[next(x.k)] - lap[x.k]));
   };
-  for (size_t i = 0; i < n; ++i) w.disp[i] = s2 * (lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
+  // Beyond the paper (PressOptions::circle_correction): on a circle of
+  // radius R the virtual neighbours' Laplacians are the vertex's turned by
+  // the chords' turning angle theta = d / R, so the second pass leaves
+  // L(C) (1 - cos theta) ~ d^4 / (4 R^3) inwards every iteration and tight
+  // curves end pressed against the inner ends of their sticks. Subtracting
+  // L(C) (1 - cos theta), theta measured between the chords to the two
+  // virtual neighbours and capped (`correction` = 1 - cos of the cap),
+  // makes circles fixed points; on straight stretches theta = 0 and the
+  // iteration is the paper's.
+  for (size_t i = 0; i < n; ++i) {
+    double c = 0;
+    if (correction > 0) {
+      const Vec2 a = point(fwd[i]) - p[i], b = p[i] - point(bwd[i]);
+      const double la = g.norm(a), lb = g.norm(b);
+      if (la > 0 && lb > 0) c = std::clamp(1 - g.dot(a, b) / (la * lb), 0.0, correction);
+    }
+    w.disp[i] = s2 * ((1 - c) * lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
+  }
 }
 
 }  // namespace
@@ -284,6 +302,7 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
   st.fresh = n - st.frozen;
   if (n == 0) return st;
   const double s2 = o.step * o.step;
+  const double correction = 1 - std::cos(std::clamp(o.circle_correction, 0.0, 90.0) * std::numbers::pi / 180);
   const int levels = std::max(1, o.levels);
   const bool weighted = o.weighting != PressOptions::Weighting::equal;
   std::vector<double> prop(size_t(per_vertex) * n, 0), weight(weighted ? size_t(per_vertex) * n : 0, 0);
@@ -335,7 +354,7 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
           if (first_barrier == m) {
             w.resize(m);
             for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
-            curve_step(m, true, d, s2, o.resample, weighted, g, w);
+            curve_step(m, true, d, s2, o.resample, weighted, correction, g, w);
             for (uint32_t i = 0; i < m; ++i) emit(b + i, w.disp[i], w.tangent[i]);
             continue;
           }
@@ -348,7 +367,7 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
             const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
             w.resize(count);
             for (uint32_t i = 0; i < count; ++i) gather(i, b + (first_barrier + k + lo + i) % m);
-            curve_step(count, false, d, s2, o.resample, weighted, g, w, loose);
+            curve_step(count, false, d, s2, o.resample, weighted, correction, g, w, loose);
             for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, w.disp[i - lo], w.tangent[i - lo]);
             k += len;
           }
