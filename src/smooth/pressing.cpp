@@ -74,12 +74,14 @@ struct Metric {
 struct Scratch {
   std::vector<Vec2> pos, lap, disp, tangent;
   std::vector<double> len, inv;  // segment lengths and their reciprocals
+  std::vector<double> shrink;    // per vertex: the circle correction's 1 - cos(theta)
   std::vector<Where> fwd, bwd;
   void resize(size_t n) {  // grows only: the kernel uses the first n entries
     if (pos.size() >= n) return;
     for (auto* v : {&pos, &lap, &disp, &tangent}) v->resize(n);
     len.resize(n);
     inv.resize(n);
+    shrink.resize(n);
     fwd.resize(n);
     bwd.resize(n);
   }
@@ -169,10 +171,19 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
     const Vec2 q = p[x.k] + x.f * (p[next(x.k)] - p[x.k]);
     return x.mirror == 0 ? q : Vec2(2 * p[x.mirror == 1 ? n - 1 : 0] - q);
   };
-  // Pass 1: Laplacian towards the virtual neighbours.
+  // Pass 1: Laplacian towards the virtual neighbours (and, for the circle
+  // correction below, 1 - cos of the turning angle between the chords).
+  double* shrink = w.shrink.data();
   for (size_t i = 0; i < n; ++i) {
     const Vec2 f = point(fwd[i]), b = point(bwd[i]);
     lap[i] = 0.5 * (f + b) - p[i];
+    if (correction > 0) {
+      const Vec2 a = f - p[i], c = p[i] - b;
+      const double aa = g.dot(a, a) * g.dot(c, c);
+      shrink[i] = aa > 0 ? std::clamp(1 - g.dot(a, c) / std::sqrt(aa), 0.0, correction) : 0;
+    } else {
+      shrink[i] = 0;
+    }
     if (tangents) {
       const Vec2 tg = f - b;
       const double l = g.norm(tg);
@@ -194,15 +205,7 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
   // virtual neighbours and capped (`correction` = 1 - cos of the cap),
   // makes circles fixed points; on straight stretches theta = 0 and the
   // iteration is the paper's.
-  for (size_t i = 0; i < n; ++i) {
-    double c = 0;
-    if (correction > 0) {
-      const Vec2 a = point(fwd[i]) - p[i], b = p[i] - point(bwd[i]);
-      const double la = g.norm(a), lb = g.norm(b);
-      if (la > 0 && lb > 0) c = std::clamp(1 - g.dot(a, b) / (la * lb), 0.0, correction);
-    }
-    w.disp[i] = s2 * ((1 - c) * lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
-  }
+  for (size_t i = 0; i < n; ++i) w.disp[i] = s2 * ((1 - shrink[i]) * lap[i] - 0.5 * (lap_at(fwd[i]) + lap_at(bwd[i])));
 }
 
 }  // namespace
