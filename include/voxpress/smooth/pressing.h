@@ -82,12 +82,11 @@ struct PressOptions {
   /// circle of radius R inwards by about s^2 d^4 / (4 R^3) per iteration,
   /// so tight curves end pressed against the inner ends of their sticks
   /// (a disk of radius 9.3 pixels: mean radius 0.09 px short; 0.01 px long
-  /// with the correction). Each vertex's
-  /// own Laplacian is scaled by cos(theta), theta the angle between its
-  /// chords to its two virtual neighbours (at most this cap), which makes
-  /// circles of radius above d / sin(cap) fixed points and leaves straight
-  /// stretches to the paper's iteration. Measured: docs/ARCHITECTURE.md,
-  /// Pressing: circle correction.
+  /// with the correction). Each vertex's own Laplacian is scaled by
+  /// cos(theta), theta the angle between its chords to its two virtual
+  /// neighbours (at most this cap), which makes circles of radius above
+  /// d / sin(cap) fixed points and leaves straight stretches to the paper's
+  /// iteration. Measured: docs/ARCHITECTURE.md, Pressing: circle correction.
   double circle_correction = 12;
   Progress* progress = nullptr;
 };
