@@ -51,16 +51,16 @@ TEST(Pressing, PropertyCorpusKeepsEveryGuarantee) {
   o.iterations = 30;
   for (const test::Case& c : test::property_volumes())
     for (const double correction : {0.0, 12.0, 45.0}) {
-    SCOPED_TRACE(c.name + " circle correction " + std::to_string(correction));
-    o.circle_correction = correction;
-    StickSurface s = extract_sticks(c.volume);
-    const PressStats st = press(s, o);
-    EXPECT_LE(st.iterations, o.iterations);
-    for (double t : s.t) ASSERT_TRUE(t >= o.margin && t <= 1 - o.margin);
-    const Mesh m = to_mesh(s);
-    const MeshCheck r = check_mesh(m);
-    ASSERT_TRUE(r.ok()) << c.name << ": " << (r.problems.empty() ? "" : r.problems[0]);
-    ASSERT_EQ(check_classification(m, c.volume).violations, 0u) << c.name;
+      SCOPED_TRACE(c.name + " circle correction " + std::to_string(correction));
+      o.circle_correction = correction;
+      StickSurface s = extract_sticks(c.volume);
+      const PressStats st = press(s, o);
+      EXPECT_LE(st.iterations, o.iterations);
+      for (double t : s.t) ASSERT_TRUE(t >= o.margin && t <= 1 - o.margin);
+      const Mesh m = to_mesh(s);
+      const MeshCheck r = check_mesh(m);
+      ASSERT_TRUE(r.ok()) << c.name << ": " << (r.problems.empty() ? "" : r.problems[0]);
+      ASSERT_EQ(check_classification(m, c.volume).violations, 0u) << c.name;
     }
 }
 
