@@ -1106,11 +1106,25 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       if (seg.region[v] >= 0) members[size_t(seg.region[v])].push_back(uint32_t(v));
     std::vector<Plane> planes(seg.flats.size());
     for (size_t f = 0; f < planes.size(); ++f) planes[f] = {seg.flats[f].index_normal, seg.flats[f].index_offset};
+    // The members of flats a and b that plane P stabs.
+    auto members_stabbed = [&](size_t a, size_t b, const Plane& P) {
+      std::vector<uint32_t> stabbed;
+      for (size_t f : {a, b})
+        for (uint32_t v : members[f])
+          if (!std::isnan(crossing(S, v, P, o.margin))) stabbed.push_back(v);
+      return stabbed;
+    };
     // The plane stabbing the cores of flats a and b: their members near
     // their own plane, then (when no plane stabs them all) only those
     // `inner` rings inside their flat, since a tilted plane's core reaches
-    // past the face's rounded edges. Returns the members it stabs.
-    auto joint = [&](size_t a, size_t b, Plane& P) {
+    // past the face's rounded edges. When that plane stabs fewer than `need`
+    // of their members (or none stabs the cores), each flat's own plane is
+    // tried too: a face split into an accurate piece and one whose core
+    // reaches onto a rounded edge (CAD part 128 seed 1's chamfer since the
+    // circle correction: 0.26 degrees apart, no plane stabbing both cores,
+    // each plane stabbing 98 % of the other's members). Returns the members
+    // the chosen plane P stabs.
+    auto joint = [&](size_t a, size_t b, double need, Plane& P) {
       std::vector<uint32_t> core, stabbed;
       std::vector<Vec3> pts;
       for (const uint32_t inner : {0u, 3u}) {
@@ -1127,10 +1141,16 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           }
         S.positions(core, pts);
         if (core.size() < 3 || !constrained_fit(S, core, pts, planes[a].n, o.margin, P)) continue;
-        for (size_t f : {a, b})
-          for (uint32_t v : members[f])
-            if (!std::isnan(crossing(S, v, P, o.margin))) stabbed.push_back(v);
+        stabbed = members_stabbed(a, b, P);
         break;
+      }
+      for (const size_t f : {a, b}) {
+        if (double(stabbed.size()) >= need) break;
+        std::vector<uint32_t> own = members_stabbed(a, b, planes[f]);
+        if (own.size() > stabbed.size()) {
+          stabbed = std::move(own);
+          P = planes[f];
+        }
       }
       return stabbed;
     };
@@ -1145,23 +1165,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           if (!touches[b] || planes[a].n.dot(planes[b].n) < cos_merge) continue;
           Plane P;
           const double need = 0.9 * double(members[a].size() + members[b].size());
-          std::vector<uint32_t> both = joint(a, b, P);
-          // No plane stabs both cores, but one flat's own plane may still
-          // stab 90 % of both flats' members: a face split into an accurate
-          // piece and one whose core reaches onto a rounded edge (CAD part
-          // 128 seed 1's chamfer since the circle correction: 0.26 degrees
-          // apart, each plane stabbing 98 % of the other's members).
-          for (const size_t f : {a, b}) {
-            if (double(both.size()) >= need) break;
-            std::vector<uint32_t> stabbed;
-            for (const size_t g : {a, b})
-              for (uint32_t v : members[g])
-                if (!std::isnan(crossing(S, v, planes[f], o.margin))) stabbed.push_back(v);
-            if (stabbed.size() > both.size()) {
-              both = std::move(stabbed);
-              P = planes[f];
-            }
-          }
+          std::vector<uint32_t> both = joint(a, b, need, P);
           if (double(both.size()) < need) continue;
           for (size_t f : {a, b})
             for (uint32_t v : members[f]) {
