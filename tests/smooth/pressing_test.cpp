@@ -169,6 +169,28 @@ TEST(Pressing, AnisotropicSpacingWorksInPhysicalSpace) {
   EXPECT_EQ(*r.classification_violations, 0u);
 }
 
+// A disk of radius R centred at (cx, cy) in a size x size binary image,
+// its contours pressed: the mean and RMS of the vertices' radial errors
+// (negative: inside the circle).
+struct DiskError {
+  double mean, rms;
+};
+DiskError pressed_disk(int size, double R, double cx, double cy, const PressOptions& o) {
+  std::vector<uint8_t> img(size_t(size * size));
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) img[size_t(y * size + x)] = (x - cx) * (x - cx) + (y - cy) * (y - cy) <= R * R;
+  Contours2D c = extract_contours(size, size, img);
+  press(c, o);
+  double sum = 0, s2 = 0;
+  for (size_t v = 0; v < c.t.size(); ++v) {
+    const auto p = c.position(v);
+    const double e = std::hypot(p[0] - cx, p[1] - cy) - R;
+    sum += e;
+    s2 += e * e;
+  }
+  return {sum / double(c.t.size()), std::sqrt(s2 / double(c.t.size()))};
+}
+
 TEST(Pressing, ArcLengthResamplingBeatsThePlainBilaplacian) {
   // The paper's Fig. 5: bilaplacian of the actual neighbours + snapping gets
   // stuck; resampling at fixed arc length converges. 3D sphere and 2D circle.
@@ -178,22 +200,8 @@ TEST(Pressing, ArcLengthResamplingBeatsThePlainBilaplacian) {
   const EvalReport b = evaluate_pressed(ShapeKind::sphere, 64, plain);
   EXPECT_LT(a.result_to_truth.rms, 0.5 * b.result_to_truth.rms);
   EXPECT_LT(a.normal_error_deg, b.normal_error_deg);
-  const double R = 20.3, cx = 30.2, cy = 29.7;
-  auto circle_rms = [&](const PressOptions& o) {
-    std::vector<uint8_t> img(61 * 61);
-    for (int y = 0; y < 61; ++y)
-      for (int x = 0; x < 61; ++x) img[size_t(y * 61 + x)] = (x - cx) * (x - cx) + (y - cy) * (y - cy) <= R * R;
-    Contours2D c = extract_contours(61, 61, img);
-    press(c, o);
-    double s2 = 0;
-    for (size_t v = 0; v < c.t.size(); ++v) {
-      const auto p = c.position(v);
-      const double e = std::hypot(p[0] - cx, p[1] - cy) - R;
-      s2 += e * e;
-    }
-    return std::sqrt(s2 / double(c.t.size()));
-  };
-  const double r_resampled = circle_rms(resampled), r_plain = circle_rms(plain);
+  const double r_resampled = pressed_disk(61, 20.3, 30.2, 29.7, resampled).rms;
+  const double r_plain = pressed_disk(61, 20.3, 30.2, 29.7, plain).rms;
   EXPECT_LT(r_resampled, 0.6 * r_plain);
   EXPECT_LT(r_resampled, 0.08);
 }
@@ -225,28 +233,10 @@ TEST(Pressing, CircleCorrectionKeepsTightCurvesRound) {
   // radial error) and a sphere at 32^3 (radius ~13 cells; result -> truth).
   PressOptions paper, corrected;
   paper.circle_correction = 0;
-  const double R = 9.3, cx = 13.2, cy = 12.7;
-  auto radial = [&](const PressOptions& o, double& rms) {
-    std::vector<uint8_t> img(27 * 27);
-    for (int y = 0; y < 27; ++y)
-      for (int x = 0; x < 27; ++x) img[size_t(y * 27 + x)] = (x - cx) * (x - cx) + (y - cy) * (y - cy) <= R * R;
-    Contours2D c = extract_contours(27, 27, img);
-    press(c, o);
-    double sum = 0, s2 = 0;
-    for (size_t v = 0; v < c.t.size(); ++v) {
-      const auto p = c.position(v);
-      const double e = std::hypot(p[0] - cx, p[1] - cy) - R;
-      sum += e;
-      s2 += e * e;
-    }
-    rms = std::sqrt(s2 / double(c.t.size()));
-    return sum / double(c.t.size());
-  };
-  double rms_p = 0, rms_c = 0;
-  const double bias_p = radial(paper, rms_p), bias_c = radial(corrected, rms_c);
-  EXPECT_LT(bias_p, 0) << "the paper's bilaplacian presses the circle inwards";
-  EXPECT_LT(std::abs(bias_c), 0.5 * std::abs(bias_p)) << bias_p << " -> " << bias_c;
-  EXPECT_LT(rms_c, rms_p);
+  const DiskError p = pressed_disk(27, 9.3, 13.2, 12.7, paper), c = pressed_disk(27, 9.3, 13.2, 12.7, corrected);
+  EXPECT_LT(p.mean, 0) << "the paper's bilaplacian presses the circle inwards";
+  EXPECT_LT(std::abs(c.mean), 0.5 * std::abs(p.mean)) << p.mean << " -> " << c.mean;
+  EXPECT_LT(c.rms, p.rms);
   const EvalReport a = evaluate_pressed(ShapeKind::sphere, 32, paper);
   const EvalReport b = evaluate_pressed(ShapeKind::sphere, 32, corrected);
   EXPECT_LT(b.result_to_truth_vox.rms, 0.8 * a.result_to_truth_vox.rms)
