@@ -57,6 +57,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"corner_vertices", st.corners},
           {"fallbacks", st.fallbacks},
           {"tangent_planes", st.tangent_planes},
+          {"past_crease", st.past_crease},
           {"wall_vertices", st.wall_vertices},
           {"final_crease_vertices", st.final_crease_vertices},
           {"curved_crease_vertices", st.curved_crease_vertices},
