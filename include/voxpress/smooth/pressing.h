@@ -87,6 +87,9 @@ struct PressOptions {
   /// neighbours (at most this cap), which makes circles of radius above
   /// d / sin(cap) fixed points and leaves straight stretches to the paper's
   /// iteration. Measured: docs/ARCHITECTURE.md, Pressing: circle correction.
+  /// Values outside [0, 90] are clamped to it. The CLI accepts [0, 45]: at
+  /// staircase and crease corners the chords turn 45 degrees or more, and
+  /// only the uncorrected operator removes those.
   double circle_correction = 12;
   Progress* progress = nullptr;
 };
