@@ -231,6 +231,29 @@ TEST(Sharpen, RimPocketsLeaveTheCurvedCreasesInPlace) {
   }
 }
 
+// A shape at 128^3 rotated by random:seed.
+struct Case {
+  ShapeKind kind;
+  int seed;
+};
+
+// The case pressed with flats once and sharpened twice: with `off` (one
+// step turned off) and with the defaults.
+struct OffOn {
+  GeneratedShape g;
+  SharpenResult off, on;
+};
+OffOn sharpen_off_on(const Case& c, const SharpenOptions& off) {
+  OffOn r{shape(c.kind, 128, c.seed), {}, {}};
+  StickSurface s = extract_sticks(r.g.volume);
+  FlatSegmentation seg;
+  const FlatOptions fo;
+  press_with_flats(s, build_slice_curves(s), {}, &fo, &seg);
+  r.off = sharpen(s, seg, off);
+  r.on = sharpen(s, seg);
+  return r;
+}
+
 TEST(Sharpen, FinalCreaseFitPlacesTheRoundedCreases) {
   // Snapping, the leftovers and the rim pockets move the flats' rims after
   // press_with_flats placed the curved vertices next to its junctions; where
@@ -248,20 +271,11 @@ TEST(Sharpen, FinalCreaseFitPlacesTheRoundedCreases) {
   // surface more than 1 %.
   SharpenOptions off;
   off.final_crease_rings = 0;
-  struct Case {
-    ShapeKind kind;
-    int seed;
-  };
   double within_off = 0, within_on = 0, rms_off = 0, rms_on = 0;
   for (const Case c : {Case{ShapeKind::cylinder, 1}, Case{ShapeKind::cylinder, 4}, Case{ShapeKind::cad_part, 4}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
-    const GeneratedShape g = shape(c.kind, 128, c.seed);
+    const auto [g, a, b] = sharpen_off_on(c, off);
     const auto truth = shape_truth(c.kind, g.linear, g.translation);
-    StickSurface s = extract_sticks(g.volume);
-    FlatSegmentation seg;
-    const FlatOptions fo;
-    press_with_flats(s, build_slice_curves(s), {}, &fo, &seg);
-    const SharpenResult a = sharpen(s, seg, off), b = sharpen(s, seg);
     EXPECT_EQ(a.stats.final_crease_vertices, 0u);
     EXPECT_GT(b.stats.final_crease_vertices, 100u);
     expect_valid(b.mesh, g.volume);
@@ -286,19 +300,10 @@ TEST(Sharpen, JunctionsPastTheCreaseJoinTheFlat) {
   // seed 2; points every quarter voxel along the labelled curves).
   SharpenOptions off;
   off.join_past_crease = false;
-  struct Case {
-    ShapeKind kind;
-    int seed;
-  };
   for (const Case c : {Case{ShapeKind::cad_part, 15}, Case{ShapeKind::cad_part, 128}, Case{ShapeKind::cylinder, 2}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
-    const GeneratedShape g = shape(c.kind, 128, c.seed);
+    const auto [g, a, b] = sharpen_off_on(c, off);
     const auto sharp = shape_truth(c.kind, g.linear, g.translation)->sharp_edges(30);
-    StickSurface s = extract_sticks(g.volume);
-    FlatSegmentation seg;
-    const FlatOptions fo;
-    press_with_flats(s, build_slice_curves(s), {}, &fo, &seg);
-    const SharpenResult a = sharpen(s, seg, off), b = sharpen(s, seg);
     EXPECT_EQ(a.stats.past_crease, 0u);
     EXPECT_GT(b.stats.past_crease, 0u);
     expect_valid(b.mesh, g.volume);
