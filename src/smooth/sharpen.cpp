@@ -789,16 +789,21 @@ struct Sharpener {
   // neighbouring flat's plane, the local solid is their intersection at a
   // convex crease and their union at a concave one (the curved vertices
   // within 2 rings below or above the flat's plane, at least 3 to 1). When
-  // its stick leaves that
-  // solid on the flat's plane, it joins the flat there (a slide along the
-  // stick: no sample changes side) and its curved neighbours become
-  // junctions. Decided for all first, then applied.
+  // its stick leaves that solid on the flat's plane, it joins the flat there
+  // (a slide along the stick: no sample changes side) and its curved
+  // neighbours become junctions. A stick nearly parallel to the flat may not
+  // cross its plane at all (the CAD part 128 seed 13: two curved vertices at
+  // a sample 1.3 voxels from the crease, the chain looping out to them):
+  // when the vertex lies within kPastSample of the flat's plane and more
+  // than that inside the side's half-space (outside it at a concave crease),
+  // it is on the flat's face and joins it where it is. Decided for all
+  // first, then applied.
   void junctions_past_crease() {
     if (!o.join_past_crease) return;
     struct Join {
       uint32_t v;
       int32_t f;
-      double t;
+      double t;  // where on its stick it goes (NaN: it stays where it is)
     };
     std::vector<Join> joins;
     std::vector<uint32_t> ring;
@@ -811,21 +816,26 @@ struct Sharpener {
           best = std::abs(height(r, x[v])), f = r;
       if (f < 0) continue;
       const double tf = flat_crossing(v, f);
-      if (!on_stick(tf)) continue;
+      const bool crossed = on_stick(tf);
+      if (!crossed && best > kPastSample) continue;
       Plane side;  // uncached (plane_of's cache would keep curved_creases from setting it)
       if (!tangent_plane(v, side)) continue;
-      const double tc = stick_crossing(v, side.n, side.c);
-      if (!std::isfinite(tc)) continue;
       size_t below = 0, above = 0;
       ring.assign(1, v);
       detail::grow_rings(ring, 2, adj_off, adj);
       for (uint32_t w : ring)
         if (label[w] < 0 && !junction[w]) (height(f, x[w]) < 0 ? below : above) += 1;
       const bool convex = below > 0 && below >= 3 * above, concave = above > 0 && above >= 3 * below;
-      if ((convex && tf < tc) || (concave && tf > tc)) joins.push_back({v, f, tf});
+      if (crossed) {
+        const double tc = stick_crossing(v, side.n, side.c);
+        if (std::isfinite(tc) && ((convex && tf < tc) || (concave && tf > tc))) joins.push_back({v, f, tf});
+      } else {
+        const double hc = side.n.dot(x[v]) - side.c;  // on the flat's plane already: where is the side's?
+        if ((convex && hc < -kPastSample) || (concave && hc > kPastSample)) joins.push_back({v, f, NAN});
+      }
     }
     for (const Join& j : joins) {
-      slide(j.v, j.t);
+      if (std::isfinite(j.t)) slide(j.v, j.t);
       label[j.v] = j.f;
       ++st.past_crease;
     }

@@ -294,13 +294,16 @@ TEST(Sharpen, JunctionsPastTheCreaseJoinTheFlat) {
   // curved junction vertex on a stick from that sample can lie past the
   // crease, on the flat; the crease vertices inserted on its edges were cut
   // back around it, and the labelled chain detoured up to a voxel off the
-  // true crease. Joining such vertices to the flat takes a third or more of
+  // true crease. Joining such vertices to the flat takes half or more of
   // the labelled points more than half a voxel from a true crease there,
-  // and the worst one closer (CAD part 128 seeds 15 / 128, cylinder 128
-  // seed 2; points every quarter voxel along the labelled curves).
+  // and the worst one closer (CAD part 128 seeds 13 / 15 / 128, cylinder 128
+  // seed 2; points every quarter voxel along the labelled curves). On seed 13
+  // the vertices' sticks do not cross the flat's plane: they join because
+  // they lie on it (without that branch its worst point stays at 1.71).
   SharpenOptions off;
   off.join_past_crease = false;
-  for (const Case c : {Case{ShapeKind::cad_part, 15}, Case{ShapeKind::cad_part, 128}, Case{ShapeKind::cylinder, 2}}) {
+  for (const Case c : {Case{ShapeKind::cad_part, 13}, Case{ShapeKind::cad_part, 15}, Case{ShapeKind::cad_part, 128},
+                       Case{ShapeKind::cylinder, 2}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
     const auto [g, a, b] = sharpen_off_on(c, off);
     const auto sharp = shape_truth(c.kind, g.linear, g.translation)->sharp_edges(30);
@@ -309,8 +312,8 @@ TEST(Sharpen, JunctionsPastTheCreaseJoinTheFlat) {
     expect_valid(b.mesh, g.volume);
     const auto la = labelled_distances(sharp, a.mesh), lb = labelled_distances(sharp, b.mesh);
     const double far_off = 1 - fraction_within(la, 0.5), far_on = 1 - fraction_within(lb, 0.5);
-    EXPECT_LT(far_on, 0.75 * far_off) << "measured 30 -> 19, 37 -> 16, 37 -> 12 points (of ~10 k, 10 k, 3 k)";
-    EXPECT_LT(lb.back(), la.back()) << "measured 1.06 -> 0.64, 0.93 -> 0.86, 1.15 -> 0.90";
+    EXPECT_LT(far_on, 0.75 * far_off) << "measured 115 -> 34, 30 -> 13, 37 -> 16, 37 -> 12 points (of 15 k, 9 k, 10 k, 3 k)";
+    EXPECT_LT(lb.back(), la.back()) << "measured 1.71 -> 0.79, 1.06 -> 0.64, 0.93 -> 0.86, 1.15 -> 0.90";
   }
 }
 

@@ -108,8 +108,10 @@ struct SharpenOptions {
   /// sharpen.cpp; press_with_flats does the placing too, FlatOptions).
   bool curved_creases = true;
   /// Beyond the paper: a curved junction vertex whose stick leaves the local
-  /// solid of its side's plane and the flat's on the flat's plane lies past
-  /// the crease and joins that flat (junctions_past_crease in sharpen.cpp).
+  /// solid of its side's quadric tangent plane and its neighbouring flat's
+  /// plane on the flat's plane (or that lies on the flat's plane, inside the
+  /// side's half-space) is past the crease and joins that flat
+  /// (junctions_past_crease in sharpen.cpp).
   bool join_past_crease = true;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
