@@ -299,7 +299,8 @@ TEST(Sharpen, JunctionsPastTheCreaseJoinTheFlat) {
   // and the worst one closer (CAD part 128 seeds 13 / 15 / 128, cylinder 128
   // seed 2; points every quarter voxel along the labelled curves). On seed 13
   // the vertices' sticks do not cross the flat's plane: they join because
-  // they lie on it (without that branch its worst point stays at 1.71).
+  // they lie on it (without that branch seed 13 ends with more such points
+  // than with the step off, and fails here).
   SharpenOptions off;
   off.join_past_crease = false;
   for (const Case c : {Case{ShapeKind::cad_part, 13}, Case{ShapeKind::cad_part, 15}, Case{ShapeKind::cad_part, 128},
