@@ -58,6 +58,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"fallbacks", st.fallbacks},
           {"tangent_planes", st.tangent_planes},
           {"past_crease", st.past_crease},
+          {"left_flat", st.left_flat},
           {"wall_vertices", st.wall_vertices},
           {"final_crease_vertices", st.final_crease_vertices},
           {"curved_crease_vertices", st.curved_crease_vertices},

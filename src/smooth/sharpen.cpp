@@ -777,71 +777,106 @@ struct Sharpener {
     }
   }
 
-  // Beyond the paper: a curved junction vertex past its crease, on the
-  // flat's face. Where a face passes through a sample, the sticks from that
-  // sample all meet the surface at it; a curved one pressed a little in
-  // stays curved, and the crease vertices inserted on its edges, whose
-  // targets lie beyond it, were cut back around it (CAD part 128: chains
-  // detouring 0.8-0.96 voxel off the true crease, its sharp Hausdorff).
-  // With its side's tangent plane (tangent_plane; falling back on the 2-ring
-  // plane as plane_of does made the CAD part at 64^3 worse, result -> truth
-  // 0.0662 -> 0.0684 on bench/compare's rotation) and the nearest
-  // neighbouring flat's plane, the local solid is their intersection at a
-  // convex crease and their union at a concave one (the curved vertices
-  // within 2 rings below or above the flat's plane, at least 3 to 1). When
-  // its stick leaves that solid on the flat's plane, it joins the flat there
-  // (a slide along the stick: no sample changes side) and its curved
-  // neighbours become junctions. A stick nearly parallel to the flat may not
-  // cross its plane at all (the CAD part 128 seed 13: two curved vertices at
-  // a sample 1.3 voxels from the crease, the chain looping out to them):
-  // when the vertex lies within kPastSample of the flat's plane and more
-  // than that inside the side's half-space (outside it at a concave crease),
-  // it is on the flat's face and joins it where it is. Decided for all
-  // first, then applied.
-  void junctions_past_crease() {
-    if (!o.join_past_crease) return;
-    struct Join {
+  // Beyond the paper: vertices on the wrong side of their crease. Where a
+  // face passes through a sample, the sticks from that sample all meet the
+  // surface at it; a curved junction vertex among them, pressed a little
+  // in, can lie on the flat's face, and the crease vertices inserted on its
+  // edges, whose targets lie beyond it, were cut back around it (CAD part
+  // 128: chains detouring 0.8-0.96 voxel off the true crease, its sharp
+  // Hausdorff). Conversely a flat's rim runs past the crease onto the curved
+  // face where the flat's plane still stabs the sticks there. Each vertex
+  // next to a flat/curved border is judged by the local solid of the flat's
+  // plane and the curved side's quadric tangent plane (tangent_plane;
+  // falling back on the 2-ring plane as plane_of does made the CAD part at
+  // 64^3 worse, result -> truth 0.0662 -> 0.0684 on bench/compare's
+  // rotation): their intersection at a convex crease, their union at a
+  // concave one (crease_kind_near). Decided for all first, then applied.
+  //  * A curved junction vertex whose stick leaves that solid on the flat's
+  //    plane joins the flat there (a slide along the stick: no sample
+  //    changes side). A stick nearly parallel to the flat may not cross its
+  //    plane at all (CAD part 128 seed 13: two curved vertices at a sample
+  //    1.3 voxels from the crease, the chain looping out to them): when the
+  //    vertex lies within kPastSample of the flat's plane and more than that
+  //    inside the side's half-space (outside at a concave crease), it joins
+  //    where it is.
+  //  * A flat member next to a curved junction, whose side's tangent plane
+  //    meets the flat at sharp_angle or more, leaves the flat when its stick
+  //    leaves the solid on that tangent plane at least kLeaveMargin before
+  //    the flat's plane; it slides there.
+  // The curved neighbours of a joined vertex, and a leaving vertex, become
+  // junctions.
+  static constexpr double kLeaveMargin = 0.05;  // cells along the stick (0.2: the CAD part's labels 3 % farther)
+
+  // +1 when the non-junction curved vertices within 2 rings of v lie below
+  // flat f's plane (a convex crease; at least 3 to 1), -1 above, else 0.
+  int crease_kind_near(uint32_t v, int32_t f, std::vector<uint32_t>& ring) const {
+    size_t below = 0, above = 0;
+    ring.assign(1, v);
+    detail::grow_rings(ring, 2, adj_off, adj);
+    for (uint32_t w : ring)
+      if (label[w] < 0 && !junction[w]) (height(f, x[w]) < 0 ? below : above) += 1;
+    return below > 0 && below >= 3 * above ? 1 : above > 0 && above >= 3 * below ? -1 : 0;
+  }
+
+  void past_creases() {
+    if (!o.past_crease) return;
+    struct Move {
       uint32_t v;
-      int32_t f;
-      double t;  // where on its stick it goes (NaN: it stays where it is)
+      int32_t label;  // the flat it joins, or -1 (it leaves its flat)
+      double t;       // where on its stick it goes (NaN: it stays where it is)
     };
-    std::vector<Join> joins;
+    std::vector<Move> moves;
     std::vector<uint32_t> ring;
     for (uint32_t v = 0; v < n; ++v) {
-      if (label[v] >= 0 || !junction[v]) continue;
-      int32_t f = -1;
-      double best = INFINITY;
-      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-        if (const int32_t r = label[adj[k]]; r >= 0 && std::abs(height(r, x[v])) < best)
-          best = std::abs(height(r, x[v])), f = r;
-      if (f < 0) continue;
-      const double tf = flat_crossing(v, f);
-      const bool crossed = on_stick(tf);
-      if (!crossed && best > kPastSample) continue;
-      Plane side;  // uncached (plane_of's cache would keep curved_creases from setting it)
-      if (!tangent_plane(v, side)) continue;
-      size_t below = 0, above = 0;
-      ring.assign(1, v);
-      detail::grow_rings(ring, 2, adj_off, adj);
-      for (uint32_t w : ring)
-        if (label[w] < 0 && !junction[w]) (height(f, x[w]) < 0 ? below : above) += 1;
-      const bool convex = below > 0 && below >= 3 * above, concave = above > 0 && above >= 3 * below;
-      if (crossed) {
-        const double tc = stick_crossing(v, side.n, side.c);
-        if (std::isfinite(tc) && ((convex && tf < tc) || (concave && tf > tc))) joins.push_back({v, f, tf});
-      } else {
-        const double hc = side.n.dot(x[v]) - side.c;  // on the flat's plane already: where is the side's?
-        if ((convex && hc < -kPastSample) || (concave && hc > kPastSample)) joins.push_back({v, f, NAN});
+      if (label[v] < 0 && junction[v]) {  // a curved junction: past the crease on the flat?
+        int32_t f = -1;
+        double best = INFINITY;
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+          if (const int32_t r = label[adj[k]]; r >= 0 && std::abs(height(r, x[v])) < best)
+            best = std::abs(height(r, x[v])), f = r;
+        if (f < 0) continue;
+        const double tf = flat_crossing(v, f);
+        const bool crossed = on_stick(tf);
+        if (!crossed && best > kPastSample) continue;
+        Plane side;  // uncached (plane_of's cache would keep curved_creases from setting it)
+        if (!tangent_plane(v, side)) continue;
+        const int kind = crease_kind_near(v, f, ring);
+        if (crossed) {
+          const double tc = stick_crossing(v, side.n, side.c);
+          if (std::isfinite(tc) && ((kind > 0 && tf < tc) || (kind < 0 && tf > tc))) moves.push_back({v, f, tf});
+        } else {
+          const double hc = side.n.dot(x[v]) - side.c;  // on the flat's plane already: where is the side's?
+          if ((kind > 0 && hc < -kPastSample) || (kind < 0 && hc > kPastSample)) moves.push_back({v, f, NAN});
+        }
+      } else if (const int32_t f = label[v]; f >= 0) {  // a member: past the crease on the curved face?
+        uint32_t w = kNone;  // its nearest curved junction neighbour
+        double d2 = INFINITY;
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+          if (const uint32_t q = adj[k]; label[q] < 0 && junction[q] && (x[q] - x[v]).squaredNorm() < d2)
+            d2 = (x[q] - x[v]).squaredNorm(), w = q;
+        if (w == kNone) continue;
+        Plane side;
+        if (!tangent_plane(w, side) || angle_deg(side.n, seg.flats[size_t(f)].index_normal) < o.sharp_angle) continue;
+        const int kind = crease_kind_near(v, f, ring);
+        const double tf = flat_crossing(v, f), tc = stick_crossing(v, side.n, side.c);
+        if (!on_stick(tc) || !std::isfinite(tf)) continue;
+        if ((kind > 0 && tc < tf - kLeaveMargin) || (kind < 0 && tc > tf + kLeaveMargin)) moves.push_back({v, -1, tc});
       }
     }
-    for (const Join& j : joins) {
-      if (std::isfinite(j.t)) slide(j.v, j.t);
-      label[j.v] = j.f;
-      ++st.past_crease;
+    for (const Move& m : moves) {
+      if (std::isfinite(m.t)) slide(m.v, m.t);
+      label[m.v] = m.label;
+      if (m.label >= 0) {
+        ++st.past_crease;
+      } else {
+        junction[m.v] = 1;
+        ++st.left_flat;
+      }
     }
-    for (const Join& j : joins)
-      for (uint32_t k = adj_off[j.v]; k < adj_off[j.v + 1]; ++k)
-        if (label[adj[k]] < 0) junction[adj[k]] = 1;
+    for (const Move& m : moves)
+      if (m.label >= 0)
+        for (uint32_t k = adj_off[m.v]; k < adj_off[m.v + 1]; ++k)
+          if (label[adj[k]] < 0) junction[adj[k]] = 1;
   }
 
   // Beyond the paper: creases between two curved faces (fandisk). Once the
@@ -1206,7 +1241,7 @@ struct Sharpener {
       join_leftovers();
       fit_walls();
       final_crease_fit();
-      junctions_past_crease();
+      past_creases();
       curved_creases();
       subdivide();
     } else {

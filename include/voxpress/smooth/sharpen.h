@@ -107,12 +107,12 @@ struct SharpenOptions {
   /// sides' quadrics and sharpened like flat borders (curved_creases in
   /// sharpen.cpp; press_with_flats does the placing too, FlatOptions).
   bool curved_creases = true;
-  /// Beyond the paper: a curved junction vertex whose stick leaves the local
-  /// solid of its side's quadric tangent plane and its neighbouring flat's
-  /// plane on the flat's plane (or that lies on the flat's plane, inside the
-  /// side's half-space) is past the crease and joins that flat
-  /// (junctions_past_crease in sharpen.cpp).
-  bool join_past_crease = true;
+  /// Beyond the paper: vertices on the wrong side of a flat/curved crease
+  /// change sides, judged by the local solid of the flat's plane and the
+  /// curved side's quadric tangent plane: a curved junction vertex past it
+  /// joins the flat, a flat member past it leaves the flat (past_creases in
+  /// sharpen.cpp).
+  bool past_crease = true;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -128,6 +128,7 @@ struct SharpenStats {
   size_t final_crease_vertices = 0;   ///< curved vertices placed again by the crease fit (final_crease_fit)
   size_t curved_crease_vertices = 0;  ///< vertices placed on creases between two curved faces (curved_creases)
   size_t past_crease = 0;             ///< curved junction vertices past their crease that joined the flat
+  size_t left_flat = 0;               ///< flat members past their crease that left the flat (past_creases)
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
