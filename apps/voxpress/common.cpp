@@ -149,7 +149,9 @@ void PressCli::bind(CLI::App& cmd, bool barriers) {
   g->add_option("--step", options.step, "s in C'' = C + s^2 L^2(C)")->capture_default_str();
   g->add_option("--arc-length", options.arc_length, "d: virtual-neighbour distance, in cells")->capture_default_str();
   g->add_option("--margin", options.margin, "Keep t in [margin, 1 - margin]")->capture_default_str();
-  g->add_option("--levels", options.levels, "Coarse-to-fine stages of d (1: the paper's single d)")
+  g->add_option("--levels", options.levels,
+                "Coarse-to-fine stages of d (1: the paper's single d; 0: by the surface's extent, 2 below 192 cells, "
+                "one more each time it doubles)")
       ->capture_default_str();
   g->add_option("--momentum", options.momentum, "Heavy-ball momentum (0: the paper's plain iteration)")
       ->capture_default_str();
@@ -181,7 +183,7 @@ PressOptions PressCli::resolve() const {
   if (o.iterations < 0) throw UsageError("--iterations must be >= 0");
   if (!(o.margin > 0 && o.margin < 0.5)) throw UsageError("--margin must be in (0, 0.5)");
   if (!(o.arc_length > 0) || !(o.step > 0)) throw UsageError("--arc-length and --step must be > 0");
-  if (o.levels < 1 || o.levels > 8) throw UsageError("--levels must be between 1 and 8");
+  if (o.levels < 0 || o.levels > 8) throw UsageError("--levels must be between 0 (automatic) and 8");
   if (!(o.momentum >= 0 && o.momentum < 1)) throw UsageError("--momentum must be in [0, 1)");
   return o;
 }
@@ -208,7 +210,7 @@ nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
   return {{"iterations", st.iterations},    {"max_iterations", o.iterations},
           {"last_max_change", st.last_max_change}, {"curves", st.curves},
           {"fresh", st.fresh},              {"frozen", st.frozen},
-          {"seconds", st.seconds},          {"levels", o.levels},
+          {"seconds", st.seconds},          {"levels", st.levels},
           {"momentum", o.momentum},         {"arc_length", o.arc_length},
           {"step", o.step},                 {"resample", o.resample},
           {"free_ends", o.free_ends}};

@@ -42,6 +42,7 @@ namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
+constexpr int64_t kFar = INT64_MAX;
 // PressOptions::free_ends: pieces from barrier to barrier of at least this
 // many segments (7 vertices between the barriers) get free ends. Measured
 // 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
@@ -295,18 +296,33 @@ struct Family {
   double cell;  // cell side of the family's planes (d = arc_length * cell)
 };
 
+// PressOptions::levels resolved: 0 = by the surface's extent in cells (the
+// longest side of its bounding box), 2 stages below 192 cells and one more
+// each time the extent doubles, so that the coarsest d covers about the same
+// share of the solid at every resolution. Measured (docs/BENCHMARKS.md,
+// Pressing, Levels by extent): at 256 a third stage takes the sphere from
+// 0.029 to 0.014 (r->t), at 128 it helps the sphere but costs the torus
+// (0.018 -> 0.022) and fandisk.
+int resolve_levels(int requested, int64_t extent) {
+  if (requested > 0) return requested;
+  int levels = 2;
+  for (int64_t e = 192; extent >= e && levels < 8; e *= 2) ++levels;
+  return levels;
+}
+
 PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
-                   const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier, const PressOptions& o) {
+                   const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier, const PressOptions& o,
+                   int levels) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = t.size();
   PressStats st;
   for (const Family& f : families) st.curves += f.offsets->size() - 1;
   for (uint8_t x : frozen) st.frozen += x != 0;
   st.fresh = n - st.frozen;
+  st.levels = levels;
   if (n == 0) return st;
   const double s2 = o.step * o.step;
   const double correction = 1 - std::cos(std::clamp(o.circle_correction, 0.0, 90.0) * std::numbers::pi / 180);
-  const int levels = std::max(1, o.levels);
   const bool weighted = o.weighting != PressOptions::Weighting::equal;
   std::vector<double> prop(size_t(per_vertex) * n, 0), weight(weighted ? size_t(per_vertex) * n : 0, 0);
   std::vector<double> velocity(o.momentum != 0 ? n : 0, 0.0);
@@ -468,7 +484,25 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
       f.dst[k] = 2 * new_of[id] + uint32_t(slot_of(a, s.axis(id)));
     });
   }
-  const PressStats st = iterate(t, families, 2, fz, br, o);
+  // The surface's extent in cells, for the coarse-to-fine stages: the
+  // longest side of the box of its sticks' samples.
+  using Box = std::array<int64_t, 6>;  // min x, y, z, max x, y, z of the lower samples
+  const Box box = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, n, 1 << 14), Box{kFar, kFar, kFar, -kFar, -kFar, -kFar},
+      [&](const tbb::blocked_range<size_t>& r, Box b) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          const auto l = s.lower_index(i);
+          for (size_t a = 0; a < 3; ++a) b[a] = std::min(b[a], l[a]), b[a + 3] = std::max(b[a + 3], l[a]);
+        }
+        return b;
+      },
+      [](Box x, const Box& y) {
+        for (size_t a = 0; a < 3; ++a) x[a] = std::min(x[a], y[a]), x[a + 3] = std::max(x[a + 3], y[a + 3]);
+        return x;
+      });
+  int64_t extent = 0;  // + 1: a stick's upper sample lies one past its lower one
+  for (size_t a = 0; n > 0 && a < 3; ++a) extent = std::max(extent, box[a + 3] + 1 - box[a]);
+  const PressStats st = iterate(t, families, 2, fz, br, o, resolve_levels(o.levels, extent));
   tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[old_of[i]] = t[i]; });
   return st;
 }
@@ -556,7 +590,14 @@ PressStats press(Contours2D& c, const PressOptions& o) {
     f.base[k] = Vec2(double(c.lower[v][0]), double(c.lower[v][1]));
     f.mov[k] = c.axis[v];
   }
-  return iterate(c.t, families, 1, {}, {}, o);
+  int64_t extent = 0;
+  if (!c.lower.empty()) {
+    std::array<int64_t, 4> b{c.lower[0][0], c.lower[0][1], c.lower[0][0], c.lower[0][1]};  // min x, y, max x, y
+    for (const auto& l : c.lower)
+      for (size_t a = 0; a < 2; ++a) b[a] = std::min<int64_t>(b[a], l[a]), b[a + 2] = std::max<int64_t>(b[a + 2], l[a]);
+    extent = std::max(b[2] - b[0], b[3] - b[1]) + 1;
+  }
+  return iterate(c.t, families, 1, {}, {}, o, resolve_levels(o.levels, extent));
 }
 
 }  // namespace voxpress

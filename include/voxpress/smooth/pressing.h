@@ -58,8 +58,13 @@ struct PressOptions {
   /// Beyond the paper — acceleration (same fixed point, reached in far fewer
   /// iterations; docs/BENCHMARKS.md has the measurements):
   /// coarse-to-fine: the iterations are split evenly into `levels` stages with
-  /// d multiplied by 2^(levels - 1), ..., 2, 1 (1: the paper's single d);
-  int levels = 2;
+  /// d multiplied by 2^(levels - 1), ..., 2, 1 (1: the paper's single d).
+  /// 0 = by the surface's extent E, the longest side of its bounding box in
+  /// cells: 2 stages while E < 192, one more each time E doubles (3 up to
+  /// 383, 4 up to 767, ...), so the coarsest d spans about the same share of
+  /// the solid at every resolution (measured: docs/BENCHMARKS.md, Pressing,
+  /// Levels by extent);
+  int levels = 0;
   /// heavy-ball momentum: each update adds momentum times the vertex's
   /// previous change of t (0: the paper's plain iteration).
   double momentum = 0.8;
@@ -96,6 +101,7 @@ struct PressOptions {
 
 struct PressStats {
   int iterations = 0;              ///< iterations run
+  int levels = 0;                  ///< coarse-to-fine stages used (PressOptions::levels resolved)
   double last_max_change = 0;      ///< largest |delta t| of the last iteration
   size_t curves = 0, fresh = 0, frozen = 0;
   double seconds = 0;
