@@ -174,13 +174,14 @@ TEST(Pressing, AnisotropicSpacingWorksInPhysicalSpace) {
 // (negative: inside the circle).
 struct DiskError {
   double mean, rms;
+  int levels;  // coarse-to-fine stages the press used
 };
 DiskError pressed_disk(int size, double R, double cx, double cy, const PressOptions& o) {
   std::vector<uint8_t> img(size_t(size * size));
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) img[size_t(y * size + x)] = (x - cx) * (x - cx) + (y - cy) * (y - cy) <= R * R;
   Contours2D c = extract_contours(size, size, img);
-  press(c, o);
+  const int levels = press(c, o).levels;
   double sum = 0, s2 = 0;
   for (size_t v = 0; v < c.t.size(); ++v) {
     const auto p = c.position(v);
@@ -188,7 +189,7 @@ DiskError pressed_disk(int size, double R, double cx, double cy, const PressOpti
     sum += e;
     s2 += e * e;
   }
-  return {sum / double(c.t.size()), std::sqrt(s2 / double(c.t.size()))};
+  return {sum / double(c.t.size()), std::sqrt(s2 / double(c.t.size())), levels};
 }
 
 TEST(Pressing, ArcLengthResamplingBeatsThePlainBilaplacian) {
@@ -252,18 +253,10 @@ TEST(Pressing, LevelsGrowWithTheExtent) {
   // contour closer to the circle than two stages in the same 100 iterations.
   PressOptions automatic, two;
   two.levels = 2;
-  const auto stages = [](int size, double R, const PressOptions& o) {
-    std::vector<uint8_t> img(size_t(size * size));
-    const double c = 0.5 * size + 0.2;
-    for (int y = 0; y < size; ++y)
-      for (int x = 0; x < size; ++x) img[size_t(y * size + x)] = (x - c) * (x - c) + (y - c + 0.3) * (y - c + 0.3) <= R * R;
-    Contours2D contours = extract_contours(size, size, img);
-    return press(contours, o).levels;
-  };
-  EXPECT_EQ(stages(61, 20.3, automatic), 2);
-  EXPECT_EQ(stages(260, 120.3, automatic), 3);
-  EXPECT_EQ(stages(260, 120.3, two), 2);
+  EXPECT_EQ(pressed_disk(61, 20.3, 30.2, 29.7, automatic).levels, 2);
   const DiskError a = pressed_disk(260, 120.3, 130.2, 129.7, automatic), b = pressed_disk(260, 120.3, 130.2, 129.7, two);
+  EXPECT_EQ(a.levels, 3);
+  EXPECT_EQ(b.levels, 2);
   EXPECT_LT(a.rms, 0.8 * b.rms) << b.rms << " -> " << a.rms;
 }
 
