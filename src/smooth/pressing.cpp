@@ -42,7 +42,6 @@ namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
-constexpr int64_t kFar = INT64_MAX;
 // PressOptions::free_ends: pieces from barrier to barrier of at least this
 // many segments (7 vertices between the barriers) get free ends. Measured
 // 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
@@ -296,15 +295,36 @@ struct Family {
   double cell;  // cell side of the family's planes (d = arc_length * cell)
 };
 
-// PressOptions::levels resolved: 0 = by the surface's extent in cells (the
-// longest side of its bounding box), 2 stages below 192 cells and one more
-// each time the extent doubles, so that the coarsest d covers about the same
-// share of the solid at every resolution. Measured (docs/BENCHMARKS.md,
-// Pressing, Levels by extent): at 256 a third stage takes the sphere from
-// 0.029 to 0.014 (r->t), at 128 it helps the sphere but costs the torus
-// (0.018 -> 0.022) and fandisk.
-int resolve_levels(int requested, int64_t extent) {
+// PressOptions::levels resolved (its comment has the rule). Only for 0 are
+// the n sticks' lower samples, lower(i) (D index coordinates), read: the
+// extent is the longest side of the box of the sticks' samples, a stick's
+// upper sample lying one past its lower one.
+template <size_t D, class Lower>
+int resolve_levels(int requested, size_t n, const Lower& lower) {
   if (requested > 0) return requested;
+  using Box = std::array<int64_t, 2 * D>;  // min, then max, of each coordinate
+  Box empty;
+  for (size_t a = 0; a < D; ++a) empty[a] = INT64_MAX, empty[a + D] = INT64_MIN;
+  const auto merge = [](Box& b, const auto& x) {
+    for (size_t a = 0; a < D; ++a) b[a] = std::min<int64_t>(b[a], x[a]), b[a + D] = std::max<int64_t>(b[a + D], x[a + D]);
+  };
+  const Box box = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, n, 1 << 14), empty,
+      [&](const tbb::blocked_range<size_t>& r, Box b) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          const auto l = lower(i);
+          Box point;
+          for (size_t a = 0; a < D; ++a) point[a] = point[a + D] = l[a];
+          merge(b, point);
+        }
+        return b;
+      },
+      [&](Box x, const Box& y) {
+        merge(x, y);
+        return x;
+      });
+  int64_t extent = 0;
+  for (size_t a = 0; n > 0 && a < D; ++a) extent = std::max(extent, box[a + D] + 1 - box[a]);
   int levels = 2;
   for (int64_t e = 192; extent >= e && levels < 8; e *= 2) ++levels;
   return levels;
@@ -484,25 +504,8 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
       f.dst[k] = 2 * new_of[id] + uint32_t(slot_of(a, s.axis(id)));
     });
   }
-  // The surface's extent in cells, for the coarse-to-fine stages: the
-  // longest side of the box of its sticks' samples.
-  using Box = std::array<int64_t, 6>;  // min x, y, z, max x, y, z of the lower samples
-  const Box box = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, n, 1 << 14), Box{kFar, kFar, kFar, -kFar, -kFar, -kFar},
-      [&](const tbb::blocked_range<size_t>& r, Box b) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-          const auto l = s.lower_index(i);
-          for (size_t a = 0; a < 3; ++a) b[a] = std::min(b[a], l[a]), b[a + 3] = std::max(b[a + 3], l[a]);
-        }
-        return b;
-      },
-      [](Box x, const Box& y) {
-        for (size_t a = 0; a < 3; ++a) x[a] = std::min(x[a], y[a]), x[a + 3] = std::max(x[a + 3], y[a + 3]);
-        return x;
-      });
-  int64_t extent = 0;  // + 1: a stick's upper sample lies one past its lower one
-  for (size_t a = 0; n > 0 && a < 3; ++a) extent = std::max(extent, box[a + 3] + 1 - box[a]);
-  const PressStats st = iterate(t, families, 2, fz, br, o, resolve_levels(o.levels, extent));
+  const int levels = resolve_levels<3>(o.levels, n, [&](size_t i) { return s.lower_index(i); });
+  const PressStats st = iterate(t, families, 2, fz, br, o, levels);
   tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[old_of[i]] = t[i]; });
   return st;
 }
@@ -590,14 +593,8 @@ PressStats press(Contours2D& c, const PressOptions& o) {
     f.base[k] = Vec2(double(c.lower[v][0]), double(c.lower[v][1]));
     f.mov[k] = c.axis[v];
   }
-  int64_t extent = 0;
-  if (!c.lower.empty()) {
-    std::array<int64_t, 4> b{c.lower[0][0], c.lower[0][1], c.lower[0][0], c.lower[0][1]};  // min x, y, max x, y
-    for (const auto& l : c.lower)
-      for (size_t a = 0; a < 2; ++a) b[a] = std::min<int64_t>(b[a], l[a]), b[a + 2] = std::max<int64_t>(b[a + 2], l[a]);
-    extent = std::max(b[2] - b[0], b[3] - b[1]) + 1;
-  }
-  return iterate(c.t, families, 1, {}, {}, o, resolve_levels(o.levels, extent));
+  const int levels = resolve_levels<2>(o.levels, c.lower.size(), [&](size_t v) { return c.lower[v]; });
+  return iterate(c.t, families, 1, {}, {}, o, levels);
 }
 
 }  // namespace voxpress
