@@ -59,6 +59,7 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"tangent_planes", st.tangent_planes},
           {"past_crease", st.past_crease},
           {"left_flat", st.left_flat},
+          {"inherited_junctions", st.inherited_junctions},
           {"wall_vertices", st.wall_vertices},
           {"final_crease_vertices", st.final_crease_vertices},
           {"curved_crease_vertices", st.curved_crease_vertices},

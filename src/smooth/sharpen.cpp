@@ -497,6 +497,33 @@ struct Sharpener {
     }
   }
 
+  // Beyond the paper: a curved junction that joined a flat (snap_to_flats,
+  // join_leftovers) and lies on its plane moved the flat's border onto its
+  // curved neighbours, so those that pass Section 3's junction test (their
+  // 2-ring plane meets the flat at sharp_angle or more) become junctions,
+  // as past_creases does for its joins. Otherwise their edges to the joined
+  // vertex are no chamfer edges (chamfer()) and the sharp curve has a gap
+  // there (CAD part 128 seed 1: 2 cells of the boss's rim, true -> labelled
+  // 1.0 voxel). A thin strip's vertex joins off the plane (join_leftovers)
+  // and moves no border: at 64^3 its heirs labelled a false crease.
+  void inherit_junctions() {
+    if (!o.inherit_junctions) return;
+    std::vector<uint32_t> heirs;
+    for (uint32_t v = 0; v < n; ++v) {
+      if (label[v] < 0 || seg.region[v] >= 0 || !junction[v] || std::abs(height(label[v], x[v])) > kPastSample) continue;
+      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+        Plane p;
+        if (const uint32_t q = adj[k]; label[q] < 0 && !junction[q] && ring_plane(q, p) &&
+                                       angle_deg(p.n, seg.flats[size_t(label[v])].index_normal) >= o.sharp_angle)
+          heirs.push_back(q);
+      }
+    }
+    for (uint32_t q : heirs) {
+      st.inherited_junctions += !junction[q];
+      junction[q] = 1;
+    }
+  }
+
   // Beyond the paper: thin walls. A plate a few cells thick has its rim
   // between two nearly opposite flats; the rim's fresh vertices are all
   // junctions with too few fresh neighbours for a plane of their own, so they
@@ -1243,6 +1270,7 @@ struct Sharpener {
     if (!seg.flats.empty()) {
       snap_to_flats();
       join_leftovers();
+      inherit_junctions();
       fit_walls();
       final_crease_fit();
       past_creases();

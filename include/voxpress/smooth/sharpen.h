@@ -113,6 +113,10 @@ struct SharpenOptions {
   /// joins the flat, a flat member past it leaves the flat (past_creases in
   /// sharpen.cpp).
   bool past_crease = true;
+  /// Beyond the paper: the curved neighbours of a curved junction that
+  /// joined a flat (snap_to_flats, join_leftovers) become junctions, so the
+  /// border keeps its chamfer edges there (inherit_junctions in sharpen.cpp).
+  bool inherit_junctions = true;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -129,6 +133,7 @@ struct SharpenStats {
   size_t curved_crease_vertices = 0;  ///< vertices placed on creases between two curved faces (curved_creases)
   size_t past_crease = 0;             ///< curved junction vertices past their crease that joined the flat
   size_t left_flat = 0;               ///< flat members past their crease that left the flat (past_creases)
+  size_t inherited_junctions = 0;     ///< curved vertices made junctions by a joined neighbour (inherit_junctions)
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
