@@ -354,6 +354,45 @@ TEST(Sharpen, JoinedJunctionsPassTheBorderOn) {
   }
 }
 
+TEST(Sharpen, JoinedVerticesTakeTheNearestPlane) {
+  // A curved vertex that joins a flat (snapping, the leftovers, the strips,
+  // the vertices past a crease) ends up on or next to the plane of the flat
+  // it joins: no flat with a member within 3 rings has a plane nearer to
+  // it. Taking the first ring that reached any flat, a strip vertex of the
+  // CAD part's bottom rim (128 seed 5) joined the bottom 1.04 cells below
+  // its plane while 0.15 from the side face's, and the crease chain
+  // detoured 0.94 voxel around it.
+  for (const int seed : {5, 7, 15}) {
+    SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
+    const GeneratedShape g = shape(ShapeKind::cad_part, 128, seed);
+    const Sharpened r = run(g.volume);
+    expect_valid(r.after, g.volume);
+    const size_t n = r.surface.stick_count();
+    const auto& region = r.after.vertex_attribute("region")->values;
+    std::vector<std::vector<uint32_t>> adj(n);
+    for (const Triangle& t : r.before.triangles)
+      for (int k = 0; k < 3; ++k) adj[t[size_t(k)]].push_back(t[size_t((k + 1) % 3)]);
+    size_t joined = 0, farther = 0;
+    for (uint32_t v = 0; v < n; ++v) {
+      if (r.seg.region[v] >= 0 || region[v] < 0) continue;
+      ++joined;
+      std::vector<uint32_t> ring{v};
+      for (int k = 0; k < 3; ++k)
+        for (size_t i = 0, end = ring.size(); i < end; ++i)
+          for (uint32_t q : adj[ring[i]])
+            if (std::find(ring.begin(), ring.end(), q) == ring.end()) ring.push_back(q);
+      const Vec3& p = r.after.positions[v];
+      const auto dist = [&](int f) { return std::abs(r.seg.flats[size_t(f)].normal.dot(p) - r.seg.flats[size_t(f)].offset); };
+      double nearest = INFINITY;
+      for (uint32_t q : ring)
+        if (region[q] >= 0) nearest = std::min(nearest, dist(int(region[q])));
+      farther += dist(int(region[v])) > nearest + 0.05;
+    }
+    EXPECT_GT(joined, 100u);
+    EXPECT_EQ(farther, 0u) << "of " << joined << " joined vertices";
+  }
+}
+
 TEST(Sharpen, FreeEndsKeepTheCurvedSideOffTheFlatsCorner) {
   // Beyond the paper (Section 4, Fig. 7): the curve pieces between barriers
   // have free ends, so the curved side of a sharp rim follows its own shape
