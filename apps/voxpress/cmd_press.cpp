@@ -60,6 +60,8 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"past_crease", st.past_crease},
           {"left_flat", st.left_flat},
           {"inherited_junctions", st.inherited_junctions},
+          {"band_joins", st.band_joins},
+          {"band_junctions", st.band_junctions},
           {"wall_vertices", st.wall_vertices},
           {"final_crease_vertices", st.final_crease_vertices},
           {"curved_crease_vertices", st.curved_crease_vertices},

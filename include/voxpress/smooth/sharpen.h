@@ -117,6 +117,11 @@ struct SharpenOptions {
   /// joined a flat (snap_to_flats, join_leftovers) become junctions, so the
   /// border keeps its chamfer edges there (inherit_junctions in sharpen.cpp).
   bool inherit_junctions = true;
+  /// Beyond the paper: curved, non-junction vertices between a flat's rim
+  /// and a sharp border that lie on the flat's plane join the flat, and
+  /// their curved neighbours past Section 3's test become junctions
+  /// (join_bands in sharpen.cpp).
+  bool on_plane_bands = true;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -134,6 +139,8 @@ struct SharpenStats {
   size_t past_crease = 0;             ///< curved junction vertices past their crease that joined the flat
   size_t left_flat = 0;               ///< flat members past their crease that left the flat (past_creases)
   size_t inherited_junctions = 0;     ///< curved vertices made junctions by a joined neighbour (inherit_junctions)
+  size_t band_joins = 0;              ///< on-plane band vertices that joined a flat (join_bands)
+  size_t band_junctions = 0;          ///< curved vertices made junctions by a joined band vertex (join_bands)
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
