@@ -512,19 +512,31 @@ struct Sharpener {
   void inherit_junctions() {
     if (!o.inherit_junctions) return;
     std::vector<uint32_t> heirs;
-    for (uint32_t v = 0; v < n; ++v) {
-      if (label[v] < 0 || seg.region[v] >= 0 || !junction[v] || std::abs(height(label[v], x[v])) > kPastSample) continue;
-      for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
-        Plane p;
-        if (const uint32_t q = adj[k]; label[q] < 0 && !junction[q] && ring_plane(q, p) &&
-                                       angle_deg(p.n, seg.flats[size_t(label[v])].index_normal) >= o.sharp_angle)
-          heirs.push_back(q);
-      }
+    for (uint32_t v = 0; v < n; ++v)
+      if (label[v] >= 0 && seg.region[v] < 0 && junction[v] && std::abs(height(label[v], x[v])) <= kPastSample)
+        sharp_neighbours(v, heirs);
+    st.inherited_junctions += mark_junctions(heirs);
+  }
+  // Section 3's junction test on the border a vertex v that joined a flat
+  // moved: its curved, non-junction neighbours whose 2-ring plane meets the
+  // flat's at sharp_angle or more are appended to `out`.
+  void sharp_neighbours(uint32_t v, std::vector<uint32_t>& out) const {
+    const Vec3& normal = seg.flats[size_t(label[v])].index_normal;
+    for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
+      Plane p;
+      if (const uint32_t q = adj[k];
+          label[q] < 0 && !junction[q] && ring_plane(q, p) && angle_deg(p.n, normal) >= o.sharp_angle)
+        out.push_back(q);
     }
-    for (uint32_t q : heirs) {
-      st.inherited_junctions += !junction[q];
+  }
+  // Makes them junctions; returns how many were not yet.
+  size_t mark_junctions(const std::vector<uint32_t>& vertices) {
+    size_t fresh = 0;
+    for (uint32_t q : vertices) {
+      fresh += !junction[q];
       junction[q] = 1;
     }
+    return fresh;
   }
 
   // Beyond the paper: thin walls. A plate a few cells thick has its rim
@@ -958,17 +970,8 @@ struct Sharpener {
       }
       st.band_joins += joins.size();
       heirs.clear();
-      for (const auto& [v, f] : joins)
-        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
-          Plane p;
-          if (const uint32_t q = adj[k]; label[q] < 0 && !junction[q] && ring_plane(q, p) &&
-                                         angle_deg(p.n, seg.flats[size_t(f)].index_normal) >= o.sharp_angle)
-            heirs.push_back(q);
-        }
-      for (uint32_t q : heirs) {
-        st.band_junctions += !junction[q];
-        junction[q] = 1;
-      }
+      for (const auto& [v, f] : joins) sharp_neighbours(v, heirs);
+      st.band_junctions += mark_junctions(heirs);
     }
   }
   static constexpr int kBandRounds = 4;
