@@ -529,6 +529,16 @@ struct Sharpener {
         out.push_back(q);
     }
   }
+  // The flat of v's 1-ring members whose plane is nearest to v (-1: none),
+  // and that distance.
+  int32_t nearest_neighbour_flat(uint32_t v, double& distance) const {
+    int32_t f = -1;
+    distance = INFINITY;
+    for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
+      if (const int32_t r = label[adj[k]]; r >= 0 && std::abs(height(r, x[v])) < distance)
+        distance = std::abs(height(r, x[v])), f = r;
+    return f;
+  }
   // Makes them junctions; returns how many were not yet.
   size_t mark_junctions(const std::vector<uint32_t>& vertices) {
     size_t fresh = 0;
@@ -875,11 +885,8 @@ struct Sharpener {
     std::vector<uint32_t> ring;
     for (uint32_t v = 0; v < n; ++v) {
       if (label[v] < 0 && junction[v]) {  // a curved junction: past the crease on the flat?
-        int32_t f = -1;
-        double best = INFINITY;
-        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-          if (const int32_t r = label[adj[k]]; r >= 0 && std::abs(height(r, x[v])) < best)
-            best = std::abs(height(r, x[v])), f = r;
+        double best;
+        const int32_t f = nearest_neighbour_flat(v, best);
         if (f < 0) continue;
         const double tf = flat_crossing(v, f);
         const bool crossed = on_stick(tf);
@@ -944,33 +951,34 @@ struct Sharpener {
   // voxels from any crease on 8 of 17 rotations.
   void join_bands() {
     if (!o.on_plane_bands) return;
-    std::vector<std::pair<uint32_t, int32_t>> joins;
+    struct Join {
+      uint32_t v;
+      int32_t flat;
+      double t;  // where the flat's plane crosses v's stick
+    };
+    std::vector<Join> joins;
     std::vector<uint32_t> heirs;
     for (int round = 0; round < kBandRounds; ++round) {
       joins.clear();  // decided before any is applied: the order does not matter
       for (uint32_t v = 0; v < n; ++v) {
         if (label[v] >= 0 || junction[v]) continue;
-        int32_t f = -1;
-        double best = INFINITY;
-        bool sharp = false;
-        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
-          const uint32_t q = adj[k];
-          if (label[q] < 0) {
-            sharp |= junction[q] != 0;
-          } else if (const double h = std::abs(height(label[q], x[v])); h < best) {
-            best = h, f = label[q];
-          }
-        }
-        if (sharp && f >= 0 && best <= kPastSample && on_stick(flat_crossing(v, f))) joins.push_back({v, f});
+        double best;
+        const int32_t f = nearest_neighbour_flat(v, best);
+        if (f < 0 || best > kPastSample) continue;
+        const double t = flat_crossing(v, f);
+        if (!on_stick(t)) continue;
+        bool sharp = false;  // next to a curved junction
+        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) sharp |= label[adj[k]] < 0 && junction[adj[k]];
+        if (sharp) joins.push_back({v, f, t});
       }
       if (joins.empty()) break;
-      for (const auto& [v, f] : joins) {
-        slide(v, flat_crossing(v, f));
-        label[v] = f;
+      for (const Join& j : joins) {
+        slide(j.v, j.t);
+        label[j.v] = j.flat;
       }
       st.band_joins += joins.size();
       heirs.clear();
-      for (const auto& [v, f] : joins) sharp_neighbours(v, heirs);
+      for (const Join& j : joins) sharp_neighbours(j.v, heirs);
       st.band_junctions += mark_junctions(heirs);
     }
   }
