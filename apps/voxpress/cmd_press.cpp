@@ -62,6 +62,8 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"inherited_junctions", st.inherited_junctions},
           {"band_joins", st.band_joins},
           {"band_junctions", st.band_junctions},
+          {"wedge_checks", st.wedge_checks},
+          {"wedge_shifts", st.wedge_shifts},
           {"wall_vertices", st.wall_vertices},
           {"final_crease_vertices", st.final_crease_vertices},
           {"curved_crease_vertices", st.curved_crease_vertices},

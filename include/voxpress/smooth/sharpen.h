@@ -29,6 +29,10 @@
 //     least-squares problem (directions the planes do not pin stay where the
 //     vertex is), and left in place when the planes meet at less than
 //     `min_angle` or the solution lies more than `max_move` cells away.
+//     Beyond the paper, on a flat/curved edge the two planes' solid must
+//     agree with the samples of the edge's sticks; where it does not, the
+//     curved side's plane moves onto the misplaced sample, or the vertex
+//     stays (sample_wedges).
 //  3. The new vertices form chains along the new edges (corners and ends
 //     fixed); the chains are smoothed with a bilaplacian, each vertex moving
 //     across its chain only and, next to a flat, within the flat's plane.
@@ -122,6 +126,12 @@ struct SharpenOptions {
   /// their curved neighbours past Section 3's test become junctions
   /// (join_bands in sharpen.cpp).
   bool on_plane_bands = true;
+  /// Beyond the paper: a flat/curved chamfer edge's two planes must agree with the
+  /// samples of its sticks (no outside sample inside both at a convex
+  /// crease, no inside sample outside both at a concave one); where they do
+  /// not, the curved side's plane moves onto the sample, or the new vertex
+  /// stays where it was inserted (sample_wedge in sharpen.cpp).
+  bool sample_wedges = true;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
@@ -141,6 +151,8 @@ struct SharpenStats {
   size_t inherited_junctions = 0;     ///< curved vertices made junctions by a joined neighbour (inherit_junctions)
   size_t band_joins = 0;              ///< on-plane band vertices that joined a flat (join_bands)
   size_t band_junctions = 0;          ///< curved vertices made junctions by a joined band vertex (join_bands)
+  size_t wedge_checks = 0;            ///< chamfer edges whose two planes' solid misplaced a sample (sample_wedge)
+  size_t wedge_shifts = 0;            ///< ... of which the curved side's plane was moved onto the sample
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   double seconds = 0;
