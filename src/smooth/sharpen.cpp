@@ -939,13 +939,15 @@ struct Sharpener {
   // 2-ring lies mostly on the plane), so neither the flats' extension nor
   // past_creases takes them, and the labelled chain ran along the rim, 1-2
   // voxels inside the true crease (CAD part 128 seeds 13 and 4: 1.8 and
-  // 1.3). Such a vertex next to a member of the flat and to a curved
-  // junction (the border there was judged sharp) joins the flat, sliding
+  // 1.3). Such a vertex next to a member of the flat with a curved
+  // junction within band_reach rings (the border there was judged sharp;
+  // 2 rings for rims that stop two rings short, cylinder 128 seed 3's cap
+  // 2.6 -> 1.7 voxels) joins the flat, sliding
   // along its stick onto the plane. After each round the curved neighbours
   // of its joins that pass Section 3's test become junctions, so the
   // chamfer edges follow the new border and the next round can go on along
   // it (up to kBandRounds; marking them only at the end left half of seed
-  // 13's band curved, 1.4 voxels). Without the junction neighbour a fillet
+  // 13's band curved, 1.4 voxels). Without a junction nearby a fillet
   // tangent to the flat (the boss's foot: no junctions there, Flats'
   // tangent test) took the band too, and its foot was labelled 11-21
   // voxels from any crease on 8 of 17 rotations.
@@ -957,7 +959,7 @@ struct Sharpener {
       double t;  // where the flat's plane crosses v's stick
     };
     std::vector<Join> joins;
-    std::vector<uint32_t> heirs;
+    std::vector<uint32_t> heirs, ring;
     for (int round = 0; round < kBandRounds; ++round) {
       joins.clear();  // decided before any is applied: the order does not matter
       for (uint32_t v = 0; v < n; ++v) {
@@ -967,8 +969,10 @@ struct Sharpener {
         if (f < 0 || best > kPastSample) continue;
         const double t = flat_crossing(v, f);
         if (!on_stick(t)) continue;
-        bool sharp = false;  // next to a curved junction
-        for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) sharp |= label[adj[k]] < 0 && junction[adj[k]];
+        ring.assign(1, v);  // a curved junction within band_reach rings
+        detail::grow_rings(ring, o.band_reach, adj_off, adj);
+        bool sharp = false;
+        for (uint32_t q : ring) sharp |= label[q] < 0 && junction[q];
         if (sharp) joins.push_back({v, f, t});
       }
       if (joins.empty()) break;

@@ -390,7 +390,7 @@ TEST(Sharpen, OnPlaneBandsJoinTheirFlat) {
     rms_off += eval(a.mesh, *truth, g.volume).result_to_truth_vox.rms;
     rms_on += eval(b.mesh, *truth, g.volume).result_to_truth_vox.rms;
   }
-  EXPECT_LT(rms_on, 1.005 * rms_off) << "measured 0.0786 -> 0.0786 summed";
+  EXPECT_LT(rms_on, 1.005 * rms_off) << "measured 0.0788 -> 0.0784 summed";
 }
 
 TEST(Sharpen, ChamferPlanesAgreeWithTheirSamples) {
@@ -426,6 +426,33 @@ TEST(Sharpen, ChamferPlanesAgreeWithTheirSamples) {
     const auto [g, a, b] = sharpen_off_on({ShapeKind::box, seed}, off);
     EXPECT_EQ(b.stats.wedge_checks, 0u);
     EXPECT_EQ(a.mesh.positions, b.mesh.positions);
+  }
+}
+
+TEST(Sharpen, OnPlaneBandsReachTwoRingDeepNotches) {
+  // A flat's rim can stop two rings short of the crease, so the band
+  // vertex next to the rim has no curved junction among its neighbours,
+  // only two rings away (the cylinder's cap, CAD part seed 22's boss top).
+  // Looking two rings out takes those bands too: the farthest true crease
+  // point comes closer, the labels stay as close, and the surface no
+  // farther from the truth.
+  SharpenOptions one;
+  one.band_reach = 1;
+  for (const Case c : {Case{ShapeKind::cylinder, 3}, Case{ShapeKind::cad_part, 22}}) {
+    SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
+    const auto [g, a, b] = sharpen_off_on(c, one);
+    const auto truth = shape_truth(c.kind, g.linear, g.translation);
+    const auto sharp = truth->sharp_edges(30);
+    EXPECT_GT(b.stats.band_joins, a.stats.band_joins);
+    expect_valid(b.mesh, g.volume);
+    const auto ca = crease_distances(sharp, a.mesh), cb = crease_distances(sharp, b.mesh);
+    const double la = labelled_distances(sharp, a.mesh).back(), lb = labelled_distances(sharp, b.mesh).back();
+    EXPECT_LT(cb.back(), 0.6 * ca.back()) << "measured 2.57 -> 1.15, 2.08 -> 1.13 voxel";
+    // The labels gained lie a little farther out (labelled -> true 1.54 ->
+    // 1.73, 1.05 -> 1.37), but the two-sided distance drops.
+    EXPECT_LT(std::max(cb.back(), lb), 0.8 * std::max(ca.back(), la)) << "measured 2.57 -> 1.73, 2.08 -> 1.37 voxel";
+    EXPECT_LE(eval(b.mesh, *truth, g.volume).result_to_truth_vox.rms, 1.001 * eval(a.mesh, *truth, g.volume).result_to_truth_vox.rms)
+        << "measured 0.02482 -> 0.02480, 0.03146 -> 0.03113";
   }
 }
 

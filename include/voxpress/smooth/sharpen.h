@@ -126,6 +126,7 @@ struct SharpenOptions {
   /// their curved neighbours past Section 3's test become junctions
   /// (join_bands in sharpen.cpp).
   bool on_plane_bands = true;
+  int band_reach = 2;  ///< rings: a band vertex needs a curved junction this close (1: a neighbour)
   /// Beyond the paper: a flat/curved chamfer edge's two planes must agree with the
   /// samples of its sticks (no outside sample inside both at a convex
   /// crease, no inside sample outside both at a concave one); where they do
