@@ -56,7 +56,8 @@ constexpr double kSeedShare = 0.3;
 // normal is within kCurvedWindow degrees of the plane's.
 constexpr int kCurvedRings = 10;
 constexpr double kCurvedWindow = 30;
-constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
+constexpr uint32_t kTangentRings[2] = {2, 6};
+constexpr double kThinRow = 0.15;  // junction test: points whose middle PCA eigenvalue is below this share of the largest are a row  // the curved side's rings fitted by the tangent test
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
 // whose normal is within kRestabWindow degrees; searched when the plane stabs
 // less than kRestabTrigger of them (not below kRestabGiveUp), or always when
@@ -1220,7 +1221,32 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         bool sharp = true;  // too few fresh vertices for a plane: squeezed between flats
         if (rs.out.size() >= 3) {
           pts.clear();
-          for (const auto& [w, d] : rs.out) pts.push_back(M * S.x[w]);
+          // Beyond the paper: fresh vertices on the plane of v's (first)
+          // flat are its rim stopped short, not the curved side. Left in,
+          // where a rim stopped a cell or two short of a crease the plane
+          // leaned halfway between the two sides, under junction_angle
+          // (CAD part 128 seed 30's boss rim: 26.6 degrees), so no junction
+          // marked the crease and the flat never reached it. Without them
+          // the points can be a thin row along the crease, whose plane is
+          // any plane through it (box 128 seed 8: the crease refit then
+          // moved a face 0.1 cell); then all of them are used.
+          if (o.junction_ring_off_plane > 0) {
+            int32_t f0 = -1;
+            for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
+            const Flat& F = seg.flats[size_t(f0)];
+            for (const auto& [w, d] : rs.out) {
+              const Vec3 p = M * S.x[w];
+              if (w == v || std::abs(F.normal.dot(p) - F.offset) > o.junction_ring_off_plane * cell) pts.push_back(p);
+            }
+            if (pts.size() >= 3) {
+              const Pca q = pca(pts);
+              if (!(q.eigenvalues(1) >= kThinRow * q.eigenvalues(2))) pts.clear();
+            }
+          }
+          if (pts.size() < 3) {
+            pts.clear();
+            for (const auto& [w, d] : rs.out) pts.push_back(M * S.x[w]);
+          }
           const Pca q = pca(pts);
           if (q.eigenvalues(1) > 1e-9 * std::max(1.0, q.eigenvalues(2))) {  // not collinear
             const Vec3 ns = q.normal;

@@ -92,6 +92,11 @@ struct FlatOptions {
   /// within junction_angle of the flat's where the vertex projects onto the
   /// flat, is a tangent (smooth) border, e.g. a fillet (0: off).
   double tangent_residual = 0.1;
+  /// Beyond the paper: the junction test's 2-ring plane leaves out the
+  /// fresh vertices within this many cells of the flat's plane (a rim
+  /// stopped short; the vertex itself stays in, and all are used when the
+  /// rest are fewer than 3 or a thin row). 0: the paper's plane.
+  double junction_ring_off_plane = 0.1;
   double cone = 3;             ///< degrees: a vertex votes for directions within this of its normal
   double tolerance = 0.3;      ///< cells: core vertices lie this close to the plane (estimate)
   double max_bend = 5;         ///< degrees: largest normal change across a flat's core (linear fit)
