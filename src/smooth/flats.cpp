@@ -56,8 +56,8 @@ constexpr double kSeedShare = 0.3;
 // normal is within kCurvedWindow degrees of the plane's.
 constexpr int kCurvedRings = 10;
 constexpr double kCurvedWindow = 30;
-constexpr uint32_t kTangentRings[2] = {2, 6};
-constexpr double kThinRow = 0.15;  // junction test: points whose middle PCA eigenvalue is below this share of the largest are a row  // the curved side's rings fitted by the tangent test
+constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
+constexpr double kThinRow = 0.15;  // junction test: points whose middle PCA eigenvalue is below this share of the largest are a row
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
 // whose normal is within kRestabWindow degrees; searched when the plane stabs
 // less than kRestabTrigger of them (not below kRestabGiveUp), or always when
@@ -1230,6 +1230,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           // the points can be a thin row along the crease, whose plane is
           // any plane through it (box 128 seed 8: the crease refit then
           // moved a face 0.1 cell); then all of them are used.
+          Pca q;
+          bool off_plane = false;  // q is the plane of the points off the flat's plane
           if (o.junction_ring_off_plane > 0) {
             int32_t f0 = -1;
             for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
@@ -1239,15 +1241,15 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
               if (w == v || std::abs(F.normal.dot(p) - F.offset) > o.junction_ring_off_plane * cell) pts.push_back(p);
             }
             if (pts.size() >= 3) {
-              const Pca q = pca(pts);
-              if (!(q.eigenvalues(1) >= kThinRow * q.eigenvalues(2))) pts.clear();
+              q = pca(pts);
+              off_plane = q.eigenvalues(1) >= kThinRow * q.eigenvalues(2);
             }
           }
-          if (pts.size() < 3) {
+          if (!off_plane) {
             pts.clear();
             for (const auto& [w, d] : rs.out) pts.push_back(M * S.x[w]);
+            q = pca(pts);
           }
-          const Pca q = pca(pts);
           if (q.eigenvalues(1) > 1e-9 * std::max(1.0, q.eigenvalues(2))) {  // not collinear
             const Vec3 ns = q.normal;
             sharp = false;
