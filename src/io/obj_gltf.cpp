@@ -91,7 +91,10 @@ void write_obj(const std::string& path, const Mesh& m) {
       const Vec3& p = m.positions[v];
       buf += "v " + fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z());
       if (!m.colors.empty())
-        for (int c = 0; c < 3; ++c) buf += " " + fmt(m.colors[v][size_t(c)] / 255.0);
+        for (int c = 0; c < 3; ++c) {
+          buf += ' ';
+          buf += fmt(m.colors[v][size_t(c)] / 255.0);
+        }
       buf += "\n";
       if (buf.size() > (1 << 20)) {
         out << buf;

@@ -31,6 +31,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/sentinel.h"
 #include "core/timing.h"
 #include "voxpress/extract/cube_cases.h"
 
@@ -40,7 +41,7 @@ using detail::seconds_since;
 
 namespace {
 
-constexpr uint32_t kNone = UINT32_MAX;
+using detail::kNone;
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
 // PressOptions::free_ends: pieces from barrier to barrier of at least this
 // many segments (7 vertices between the barriers) get free ends. Measured

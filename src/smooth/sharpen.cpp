@@ -16,6 +16,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "core/sentinel.h"
 #include "core/predicates.h"
 #include "crease_fit.h"
 #include "quadric.h"
@@ -26,7 +27,7 @@ namespace {
 
 using detail::degrees_between;
 using detail::Plane;
-constexpr uint32_t kNone = UINT32_MAX;
+using detail::kNone;
 constexpr double kPi = std::numbers::pi;
 constexpr int kBucket = 2;       // cells per side of the buckets of the local intersection test
 constexpr int kNearBlock = 4;    // cells per side of the blocks that decide which triangles it sees

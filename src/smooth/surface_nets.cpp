@@ -18,6 +18,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/sentinel.h"
 #include "core/timing.h"
 #include "smooth/surface_graph.h"
 
@@ -27,7 +28,7 @@ using detail::seconds_since;
 
 namespace {
 
-constexpr uint32_t kNone = UINT32_MAX;
+using detail::kNone;
 constexpr int kSlotOffset[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 
 Vec3 index_vec(const std::array<int64_t, 3>& i) { return {double(i[0]), double(i[1]), double(i[2])}; }

@@ -5,13 +5,14 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/sentinel.h"
 #include "voxpress/core/error.h"
 #include "voxpress/voxart/polygonize.h"
 
 namespace voxpress {
 namespace {
 
-constexpr uint32_t kNone = UINT32_MAX;
+using detail::kNone;
 
 uint32_t find(std::vector<uint32_t>& parent, uint32_t x) {
   while (parent[x] != x) {

@@ -57,7 +57,7 @@ struct VoxModel {
 
 using Dict = std::map<std::string, std::string>;
 
-struct Node {
+struct SceneNode {
   enum Kind { transform, group, shape } kind = transform;
   Dict attributes;
   Dict frame;                   // transform: the first frame's attributes
@@ -138,7 +138,7 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
   std::vector<VoxModel> models;
   std::array<Rgba, 256> palette = magicavoxel_default_palette();
   bool has_palette = false;
-  std::map<int32_t, Node> nodes;
+  std::map<int32_t, SceneNode> nodes;
   std::map<int32_t, bool> hidden_layers;
   uint64_t voxel_total = 0;
   while (c.pos() < end) {
@@ -184,10 +184,10 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
         has_palette = true;
       } else if (id == "nTRN" || id == "nGRP" || id == "nSHP") {
         const int32_t nid = body.i32("scene node");
-        Node node;
+        SceneNode node;
         node.attributes = read_dict(path, body);
         if (id == "nTRN") {
-          node.kind = Node::transform;
+          node.kind = SceneNode::transform;
           node.children.push_back(body.i32("nTRN chunk"));
           body.i32("nTRN chunk");  // reserved
           node.layer = body.i32("nTRN chunk");
@@ -197,12 +197,12 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
             if (f == 0) node.frame = std::move(d);  // the first key frame places the node
           }
         } else if (id == "nGRP") {
-          node.kind = Node::group;
+          node.kind = SceneNode::group;
           const uint32_t n = body.u32("nGRP chunk");
           if (uint64_t(n) * 4 > body.left()) throw InputError(path, "truncated nGRP chunk");
           for (uint32_t i = 0; i < n; ++i) node.children.push_back(body.i32("nGRP chunk"));
         } else {
-          node.kind = Node::shape;
+          node.kind = SceneNode::shape;
           const uint32_t n = body.u32("nSHP chunk");
           for (uint32_t i = 0; i < n; ++i) {
             const int32_t model = body.i32("nSHP chunk");
@@ -258,13 +258,13 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
       if (it.depth > nodes.size()) throw InputError(path, "the scene graph has a cycle");
       auto found = nodes.find(it.node);
       if (found == nodes.end()) throw InputError(path, "scene node " + std::to_string(it.node) + " is referenced but missing");
-      const Node& n = found->second;
-      if (n.kind == Node::transform) {
+      const SceneNode& n = found->second;
+      if (n.kind == SceneNode::transform) {
         auto h = n.attributes.find("_hidden");
         if (h != n.attributes.end() && h->second == "1") continue;
         if (auto l = hidden_layers.find(n.layer); l != hidden_layers.end() && l->second) continue;
         stack.push_back({n.children[0], parse_frame(path, n.frame).then(it.place), it.depth + 1});
-      } else if (n.kind == Node::group) {
+      } else if (n.kind == SceneNode::group) {
         for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch) stack.push_back({*ch, it.place, it.depth + 1});
       } else {
         for (int32_t m : n.children) {
