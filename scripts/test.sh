@@ -6,9 +6,13 @@
 # exactly this. VOXPRESS_NO_SANITIZE=1 skips the second part (local use).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+# Elapsed time at each phase's end (CI's budget: docs/RELIABILITY.md).
+phase() { echo "== $1 at $((SECONDS / 60)) min $((SECONDS % 60)) s" >&2; }
 "$root/scripts/setup.sh" --tests
+phase "setup and Release build done"
 cd "$root/build"
 ctest --output-on-failure -j "$(nproc)"
+phase "Release suite done"
 [ "${VOXPRESS_NO_SANITIZE:-0}" = 1 ] && exit 0
 
 echo "== the unit and property tests under ASan + UBSan" >&2
@@ -16,6 +20,7 @@ suites=(core_tests extract_tests io_tests eval_tests smooth_tests voxart_tests r
 cmake -S "$root" -B "$root/build-asan" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g0" \
   -DCMAKE_C_FLAGS_SANITIZE="-O1 -g0" -DVOXPRESS_SANITIZE=ON -DVOXPRESS_PYTHON=OFF -DVOXPRESS_BUILD_BENCH=OFF >/dev/null
 cmake --build "$root/build-asan" -j "$(nproc)" --target "${suites[@]}" >&2
+phase "sanitized build done"
 # Each suite's executable directly (the CLI, Python and browser tests ran in
 # Release above), two at a time; any sanitizer report fails the suite. Left
 # out: the fidelity checks at 64-128^3 (10-160 s each under ASan), which run
@@ -42,3 +47,4 @@ printf '%s\n' "${runs[@]}" | xargs -P "$(nproc)" -I{} sh -c '
   GTEST_SHARD_INDEX=$i GTEST_TOTAL_SHARDS=$n "$0/build-asan/tests/$t" --gtest_brief=1 > "$log" 2>&1 &&
     echo "sanitized $t ($((i + 1))/$n): passed" ||
     { echo "sanitized $t ($((i + 1))/$n): FAILED"; tail -40 "$log"; exit 1; }' "$root" {}
+phase "sanitized suites done"
