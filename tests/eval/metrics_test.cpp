@@ -1,15 +1,15 @@
 // Each metric against an analytic answer.
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include <numbers>
+
 #include "test_util.h"
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/voxelize.h"
 
-#include <tbb/info.h>
-#include <tbb/task_arena.h>
-
 namespace voxpress {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The box truth's own surface as a mesh (half extents 1, 0.75, 0.5).
 Mesh box_mesh(const Mat3& rotate = Mat3::Identity(), const Vec3& shift = Vec3::Zero()) {
@@ -101,7 +101,7 @@ Expected box_quadrature(const Mat3& R, const Vec3& t) {
           area += cell;
         }
     }
-  return {sum / area, std::sqrt(sum2 / area), max, angle / area * 180 / kPi};
+  return {sum / area, std::sqrt(sum2 / area), max, angle / area * 180 / std::numbers::pi};
 }
 
 TEST(Metrics, TranslatedBoxMatchesQuadrature) {

@@ -1,12 +1,12 @@
 // Truths: exact closest points, uniform area samples, areas, sharp edges.
+#include <numbers>
+
 #include "../../src/eval/polygon.h"
 #include "test_util.h"
 #include "voxpress/eval/truth.h"
 
 namespace voxpress {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(Truth, AnalyticClosestPointsBeatEveryDenseSample) {
   // The exact closest point can never be farther than the nearest of many
@@ -36,8 +36,8 @@ TEST(Truth, AnalyticClosestPointsBeatEveryDenseSample) {
 
 TEST(Truth, SamplesAreUniformByArea) {
   const auto sphere = shape_truth(ShapeKind::sphere, 2 * Mat3::Identity(), Vec3::Zero());
-  EXPECT_NEAR(sphere->area(), 16 * kPi, 1e-9);
-  EXPECT_NEAR(sphere->volume(), 32.0 / 3 * kPi, 1e-9);
+  EXPECT_NEAR(sphere->area(), 16 * std::numbers::pi, 1e-9);
+  EXPECT_NEAR(sphere->volume(), 32.0 / 3 * std::numbers::pi, 1e-9);
   // Uniform on a sphere: each coordinate of the normal is uniform on [-1, 1].
   int upper = 0;
   Vec3 mean = Vec3::Zero();
@@ -57,8 +57,8 @@ TEST(Truth, SamplesAreUniformByArea) {
     const SurfacePoint s = torus->sample(2, uint64_t(i));
     outer += std::hypot(s.point.x(), s.point.y()) > 1.0;
   }
-  EXPECT_NEAR(double(outer) / n, (1.0 + 2 * 0.4 / kPi) / 2, 0.005);
-  EXPECT_NEAR(torus->area(), 4 * kPi * kPi * 0.4, 1e-9);
+  EXPECT_NEAR(double(outer) / n, (1.0 + 2 * 0.4 / std::numbers::pi) / 2, 0.005);
+  EXPECT_NEAR(torus->area(), 4 * std::numbers::pi * std::numbers::pi * 0.4, 1e-9);
 }
 
 TEST(Truth, MeshTruthMatchesAnalyticOnAFineSphere) {
@@ -91,14 +91,14 @@ TEST(Truth, SharpEdges) {
   double cyl = 0;
   for (const auto& e : shape_truth(ShapeKind::cylinder, Mat3::Identity(), Vec3::Zero())->sharp_edges(30))
     cyl += (e[1] - e[0]).norm();
-  EXPECT_NEAR(cyl, 2 * 2 * kPi * 0.6, 1e-3);
+  EXPECT_NEAR(cyl, 2 * 2 * std::numbers::pi * 0.6, 1e-3);
   // The CAD part: outlines, chamfer, +x corners, hole rims and the boss rim
   // (19.941 model units); fillets and rounded corners are tangent, not sharp.
   double cad = 0;
   for (const auto& e : shape_truth(ShapeKind::cad_part, Mat3::Identity(), Vec3::Zero())->sharp_edges(30))
     cad += (e[1] - e[0]).norm();
-  const double expected = (1.4 + 3.6 + 1.0 + kPi * 0.2) + (3.3 + 1.0 + kPi * 0.2 + 1.4) + 1.4 + 2 * 0.15 * std::sqrt(2.0) +
-                          0.7 + 2 * 2 * kPi * 0.18 + 2 * kPi * 0.35;
+  const double expected = (1.4 + 3.6 + 1.0 + std::numbers::pi * 0.2) + (3.3 + 1.0 + std::numbers::pi * 0.2 + 1.4) + 1.4 + 2 * 0.15 * std::sqrt(2.0) +
+                          0.7 + 2 * 2 * std::numbers::pi * 0.18 + 2 * std::numbers::pi * 0.35;
   EXPECT_NEAR(cad, expected, 1e-3);
 }
 
@@ -144,7 +144,7 @@ TEST(Polygon, EarClippingWithHolesCoversTheExactArea) {
   std::vector<detail::Point2> ring, h1, h2;
   const int n = 256;
   for (int i = 0; i < n; ++i) {
-    const double a = 2 * kPi * i / n;
+    const double a = 2 * std::numbers::pi * i / n;
     ring.push_back({5 * std::cos(a), 5 * std::sin(a)});
     h1.push_back({-2 + std::cos(-a), std::sin(-a)});
     h2.push_back({2 + 1.5 * std::cos(-a), 0.5 + 1.5 * std::sin(-a)});
@@ -152,7 +152,7 @@ TEST(Polygon, EarClippingWithHolesCoversTheExactArea) {
   std::vector<detail::Point2> all2 = ring;
   all2.insert(all2.end(), h1.begin(), h1.end());
   all2.insert(all2.end(), h2.begin(), h2.end());
-  const double polygon_area = 0.5 * n * std::sin(2 * kPi / n) * (25 - 1 - 2.25);
+  const double polygon_area = 0.5 * n * std::sin(2 * std::numbers::pi / n) * (25 - 1 - 2.25);
   EXPECT_NEAR(area_of(all2, detail::triangulate_polygon(ring, {h1, h2})), polygon_area, 1e-9);
 }
 

@@ -23,10 +23,6 @@ std::vector<uint8_t> picture(int w, int h) {
   return g;
 }
 
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 TEST(ImageIo, PngAndNetpbmVariantsReadTheSamePicture) {
   test::TempDir tmp;
   const int w = 23, h = 17;
@@ -36,16 +32,16 @@ TEST(ImageIo, PngAndNetpbmVariantsReadTheSamePicture) {
   write_png(tmp.path("a.png"), w, h, rgba);
   const std::string header = std::to_string(w) + " " + std::to_string(h);
   // Binary PGM, ASCII PGM with a comment, 16-bit PGM, binary PPM.
-  write_bytes(tmp.path("b.pgm"), "P5\n" + header + "\n255\n" + std::string(g.begin(), g.end()));
+  test::write_file(tmp.path("b.pgm"), "P5\n" + header + "\n255\n" + std::string(g.begin(), g.end()));
   std::string ascii = "P2\n# made by the test\n" + header + "\n255\n";
   for (uint8_t v : g) ascii += std::to_string(v) + " ";
-  write_bytes(tmp.path("c.pgm"), ascii);
+  test::write_file(tmp.path("c.pgm"), ascii);
   std::string wide = "P5\n" + header + "\n65535\n";
   for (uint8_t v : g) wide += std::string{char(v), char(v)};  // v * 257
-  write_bytes(tmp.path("d.pgm"), wide);
+  test::write_file(tmp.path("d.pgm"), wide);
   std::string ppm = "P6\n" + header + "\n255\n";
   for (uint8_t v : g) ppm += std::string(3, char(v));
-  write_bytes(tmp.path("e.ppm"), ppm);
+  test::write_file(tmp.path("e.ppm"), ppm);
   for (const std::string name : {"a.png", "b.pgm", "c.pgm", "d.pgm", "e.ppm"}) {
     SCOPED_TRACE(name);
     const GreyImage img = read_image(tmp.path(name));
@@ -65,8 +61,8 @@ TEST(ImageIo, PngAndNetpbmVariantsReadTheSamePicture) {
     p1 += "\n";
     p4 += std::string(row.begin(), row.end());
   }
-  write_bytes(tmp.path("f.pbm"), p1);
-  write_bytes(tmp.path("g.pbm"), p4);
+  test::write_file(tmp.path("f.pbm"), p1);
+  test::write_file(tmp.path("g.pbm"), p4);
   for (const std::string name : {"f.pbm", "g.pbm"}) {
     const GreyImage img = read_image(tmp.path(name));
     ASSERT_EQ(img.width, w);
@@ -80,14 +76,14 @@ TEST(ImageIo, BadImagesNameTheFileAndTheProblem) {
   std::vector<uint8_t> rgba(g.size() * 4, 255);
   write_png(tmp.path("ok.png"), 40, 30, rgba);
   const std::string png = test::read_file(tmp.path("ok.png"));
-  write_bytes(tmp.path("trunc.png"), png.substr(0, png.size() / 2));
-  write_bytes(tmp.path("notpng.png"), "hello, this is not a PNG");
-  write_bytes(tmp.path("trunc.pgm"), "P5\n40 30\n255\n" + std::string(100, 'x'));
-  write_bytes(tmp.path("huge.pgm"), "P5\n2000000000 2000000000\n255\n");
-  write_bytes(tmp.path("maxval.pgm"), "P5\n4 4\n0\n" + std::string(16, 'x'));
-  write_bytes(tmp.path("header.pgm"), "P5\n4 four\n255\n");
-  write_bytes(tmp.path("notpbm.pgm"), "GIF89a");
-  write_bytes(tmp.path("a.gif"), "GIF89a");
+  test::write_file(tmp.path("trunc.png"), png.substr(0, png.size() / 2));
+  test::write_file(tmp.path("notpng.png"), "hello, this is not a PNG");
+  test::write_file(tmp.path("trunc.pgm"), "P5\n40 30\n255\n" + std::string(100, 'x'));
+  test::write_file(tmp.path("huge.pgm"), "P5\n2000000000 2000000000\n255\n");
+  test::write_file(tmp.path("maxval.pgm"), "P5\n4 4\n0\n" + std::string(16, 'x'));
+  test::write_file(tmp.path("header.pgm"), "P5\n4 four\n255\n");
+  test::write_file(tmp.path("notpbm.pgm"), "GIF89a");
+  test::write_file(tmp.path("a.gif"), "GIF89a");
   const std::pair<std::string, std::string> cases[] = {
       {"missing.png", "no such file"}, {"trunc.png", "PNG"},       {"notpng.png", "not a readable PNG"},
       {"trunc.pgm", "truncated"},      {"huge.pgm", "absurd"},     {"maxval.pgm", "maxval"},

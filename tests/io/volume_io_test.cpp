@@ -12,11 +12,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 std::string gzip(const std::string& s) {
   z_stream zs{};
   deflateInit2(&zs, 6, Z_DEFLATED, 16 + 15, 8, Z_DEFAULT_STRATEGY);
@@ -127,8 +122,8 @@ TEST(VolumeIO, ReadsNifti2WithSformAndScaling) {
   std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
   bytes.append(4, '\0');
   for (int16_t i = 0; i < 24; ++i) bytes.append(reinterpret_cast<const char*>(&i), 2);
-  write_bytes(tmp.path("v2.nii"), bytes);
-  write_bytes(tmp.path("v2.nii.gz"), gzip(bytes));
+  test::write_file(tmp.path("v2.nii"), bytes);
+  test::write_file(tmp.path("v2.nii.gz"), gzip(bytes));
   for (const std::string name : {"v2.nii", "v2.nii.gz"}) {
     SCOPED_TRACE(name);
     const ScalarVolume v = read_volume(tmp.path(name));
@@ -139,7 +134,7 @@ TEST(VolumeIO, ReadsNifti2WithSformAndScaling) {
     EXPECT_EQ(v.value(7), 0.5 * 7 + 1);
   }
   // Truncated NIfTI-2 payload.
-  write_bytes(tmp.path("short2.nii"), bytes.substr(0, bytes.size() - 10));
+  test::write_file(tmp.path("short2.nii"), bytes.substr(0, bytes.size() - 10));
   expect_input_error([&] { read_volume(tmp.path("short2.nii")); }, "short2.nii", "truncated");
 }
 
@@ -151,7 +146,7 @@ TEST(VolumeIO, NrrdVariants) {
     data.push_back(char((x >> 8) & 0xff));
     data.push_back(char(x & 0xff));
   }
-  write_bytes(tmp.path("be.nrrd"), "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 2 2\nspacings: 0.5 2 -3\n"
+  test::write_file(tmp.path("be.nrrd"), "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 2 2\nspacings: 0.5 2 -3\n"
                                    "endian: big\nencoding: raw\n\n" + data);
   ScalarVolume v = read_volume(tmp.path("be.nrrd"));
   EXPECT_EQ(v.value(2), 300);
@@ -159,29 +154,29 @@ TEST(VolumeIO, NrrdVariants) {
   EXPECT_EQ(v.lattice.spacing, Vec3(0.5, 2, 3));
   EXPECT_EQ(v.lattice.direction(2, 2), -1);
   // Detached header with a data file, and with a LIST of files.
-  write_bytes(tmp.path("vol.raw"), std::string("\x01\x00\x01\x00\x00\x01\x00\x01", 8));
-  write_bytes(tmp.path("det.nhdr"), "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+  test::write_file(tmp.path("vol.raw"), std::string("\x01\x00\x01\x00\x00\x01\x00\x01", 8));
+  test::write_file(tmp.path("det.nhdr"), "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                                     "space: RAS\nspace directions: (1,0,0) (0,1,0) (0,0,1)\ndata file: vol.raw\n");
   v = read_volume(tmp.path("det.nhdr"));
   EXPECT_EQ(v.lattice.space, Space::RAS);
   EXPECT_EQ(binarize(v).count_inside(), 4u);
-  write_bytes(tmp.path("s0.raw"), std::string("\x01\x00\x01\x00", 4));
-  write_bytes(tmp.path("s1.raw"), std::string("\x00\x01\x00\x01", 4));
-  write_bytes(tmp.path("list.nhdr"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+  test::write_file(tmp.path("s0.raw"), std::string("\x01\x00\x01\x00", 4));
+  test::write_file(tmp.path("s1.raw"), std::string("\x00\x01\x00\x01", 4));
+  test::write_file(tmp.path("list.nhdr"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
                                      "data file: LIST\ns0.raw\ns1.raw\n");
   v = read_volume(tmp.path("list.nhdr"));
   EXPECT_EQ(v.value(4), 0);
   EXPECT_EQ(v.value(5), 1);
   // Text encoding and gzip members concatenated.
-  write_bytes(tmp.path("txt.nrrd"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: text\n\n1.5 -2\n");
+  test::write_file(tmp.path("txt.nrrd"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: text\n\n1.5 -2\n");
   v = read_volume(tmp.path("txt.nrrd"));
   EXPECT_EQ(v.value(0), 1.5);
-  write_bytes(tmp.path("multi.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 1 1\nencoding: gzip\n\n" +
+  test::write_file(tmp.path("multi.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 1 1\nencoding: gzip\n\n" +
                                           gzip(std::string("\x01\x02", 2)) + gzip(std::string("\x03\x04", 2)));
   v = read_volume(tmp.path("multi.nrrd"));
   EXPECT_EQ(v.value(3), 4);
   // LAS space becomes RAS (x mirrored).
-  write_bytes(tmp.path("las.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
+  test::write_file(tmp.path("las.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
                                     "space: left-anterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n"
                                     "space origin: (10,20,30)\n\n" + std::string(1, '\1'));
   v = read_volume(tmp.path("las.nrrd"));
@@ -189,7 +184,7 @@ TEST(VolumeIO, NrrdVariants) {
   EXPECT_EQ(v.lattice.origin, Vec3(-10, 20, 30));
   EXPECT_EQ(v.lattice.direction(0, 0), -1);
   // Unsupported encoding gets a clear message.
-  write_bytes(tmp.path("bz.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: bzip2\n\nxx");
+  test::write_file(tmp.path("bz.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: bzip2\n\nxx");
   expect_input_error([&] { read_volume(tmp.path("bz.nrrd")); }, "bz.nrrd", "bzip2");
 }
 
@@ -200,7 +195,7 @@ TEST(VolumeIO, SlicerSegmentations) {
       "Segment1_ID:=Segment_2\nSegment1_Name:=tumour\nSegment1_LabelValue:=1\nSegment1_Layer:=1\n"
       "Segment2_ID:=Segment_3\nSegment2_Name:=vessel\nSegment2_LabelValue:=2\nSegment2_Layer:=1\n";
   // 4-D layered file: 2 layers first (list axis), then 2 x 1 x 1 samples.
-  write_bytes(tmp.path("layers.seg.nrrd"),
+  test::write_file(tmp.path("layers.seg.nrrd"),
               "NRRD0004\ntype: unsigned char\ndimension: 4\nspace: left-posterior-superior\nsizes: 2 2 1 1\n"
               "space directions: none (1,0,0) (0,1,0) (0,0,1)\nkinds: list domain domain domain\n"
               "encoding: raw\nspace origin: (0,0,0)\n" + keys + "\n" + std::string("\x01\x02\x00\x01", 4));
@@ -244,7 +239,7 @@ TEST(VolumeIO, RawWithExplicitLayout) {
   test::TempDir tmp;
   std::string bytes = "HEAD";
   for (uint16_t x : {0, 1, 0, 1, 1, 1}) bytes.append(reinterpret_cast<const char*>(&x), 2);
-  write_bytes(tmp.path("v.raw"), bytes);
+  test::write_file(tmp.path("v.raw"), bytes);
   ReadOptions o;
   o.raw = RawLayout{{3, 2, 1}, ScalarType::u16, Vec3(1, 2, 3), Vec3(0, 0, 0), false, 4};
   const ScalarVolume v = read_volume(tmp.path("v.raw"), o);
@@ -260,9 +255,9 @@ TEST(VolumeIO, RawWithExplicitLayout) {
 TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
   test::TempDir tmp;
   expect_input_error([&] { read_volume(tmp.path("missing.nrrd")); }, "missing.nrrd", "no such file");
-  write_bytes(tmp.path("thing.xyz"), "abc");
+  test::write_file(tmp.path("thing.xyz"), "abc");
   expect_input_error([&] { read_volume(tmp.path("thing.xyz")); }, "thing.xyz", "unknown volume format");
-  write_bytes(tmp.path("notnrrd.nrrd"), "hello\n");
+  test::write_file(tmp.path("notnrrd.nrrd"), "hello\n");
   expect_input_error([&] { read_volume(tmp.path("notnrrd.nrrd")); }, "notnrrd.nrrd", "not a NRRD");
   // Truncated payloads.
   const ScalarVolume v = random_volume(ScalarType::u16, {10, 10, 10}, 3);
@@ -276,14 +271,14 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
     expect_input_error([&] { read_volume(tmp.path(name)); }, name, name.ends_with(".nii.gz") ? "corrupt" : "truncated");
   }
   // Header dimensions that do not match the data.
-  write_bytes(tmp.path("big.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
+  test::write_file(tmp.path("big.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
                                         std::string(12, '\1'));
   expect_input_error([&] { read_volume(tmp.path("big.nrrd")); }, "big.nrrd", "does not match");
-  write_bytes(tmp.path("gzbig.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n" +
+  test::write_file(tmp.path("gzbig.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n" +
                                           gzip(std::string(12, '\1')));
   expect_input_error([&] { read_volume(tmp.path("gzbig.nrrd")); }, "gzbig.nrrd", "more than");
   // Absurd dimensions are refused before allocating (a gzip bomb in the making).
-  write_bytes(tmp.path("bomb.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 100000 100000 100000\n"
+  test::write_file(tmp.path("bomb.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 100000 100000 100000\n"
                                      "encoding: gzip\n\n" + gzip(std::string(1000, '\0')));
   try {
     read_volume(tmp.path("bomb.nrrd"));
@@ -295,14 +290,14 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
   ReadOptions small;
   small.max_bytes = 1000;
   EXPECT_THROW(read_volume(tmp.path("t.nrrd"), small), LimitError);
-  write_bytes(tmp.path("over.nrrd"), "NRRD0004\ntype: double\ndimension: 3\nsizes: 4294967296 4294967296 4294967296\n"
+  test::write_file(tmp.path("over.nrrd"), "NRRD0004\ntype: double\ndimension: 3\nsizes: 4294967296 4294967296 4294967296\n"
                                      "encoding: raw\n\n");
   EXPECT_THROW(read_volume(tmp.path("over.nrrd")), LimitError);
-  write_bytes(tmp.path("neg.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 -2 2\nencoding: raw\n\n");
+  test::write_file(tmp.path("neg.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 -2 2\nencoding: raw\n\n");
   expect_input_error([&] { read_volume(tmp.path("neg.nrrd")); }, "neg.nrrd", "invalid dimension");
-  write_bytes(tmp.path("junk.nii"), std::string(400, 'x'));
+  test::write_file(tmp.path("junk.nii"), std::string(400, 'x'));
   expect_input_error([&] { read_volume(tmp.path("junk.nii")); }, "junk.nii", "NIfTI");
-  write_bytes(tmp.path("junk.tif"), std::string(400, 'x'));
+  test::write_file(tmp.path("junk.tif"), std::string(400, 'x'));
   expect_input_error([&] { read_volume(tmp.path("junk.tif")); }, "junk.tif", "TIFF");
   // No temporary or partial output is left by a failed write.
   EXPECT_THROW(write_volume(tmp.path("nowhere/x.nrrd"), v), InputError);
