@@ -57,7 +57,9 @@ constexpr double kSeedShare = 0.3;
 constexpr int kCurvedRings = 10;
 constexpr double kCurvedWindow = 30;
 constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
-constexpr double kThinRow = 0.15;  // junction test: points whose middle PCA eigenvalue is below this share of the largest are a row
+// Junction test: points whose middle PCA eigenvalue is below this share of
+// the largest are a row (their plane is arbitrary).
+constexpr double kThinRow = 0.15;
 // Detector::restab (near-axis faces): candidates within kRestabRings rings
 // whose normal is within kRestabWindow degrees; searched when the plane stabs
 // less than kRestabTrigger of them (not below kRestabGiveUp), or always when
@@ -1212,9 +1214,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       detail::RingScratch& rs = scratch.local();
       for (size_t v = r.begin(); v < r.end(); ++v) {
         if (seg.region[v] >= 0) continue;
-        bool near_flat = false;
-        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) near_flat |= seg.region[S.adj[k]] >= 0;
-        if (!near_flat) continue;
+        int32_t f0 = -1;  // v's first flat neighbour
+        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
+        if (f0 < 0) continue;
         // Fresh vertices of the 2-ring (v included), in physical space.
         const auto fresh = [&](uint32_t w) { return seg.region[w] < 0; };
         detail::rings_around(uint32_t(v), 2, S.adj_off, S.adj, fresh, rs);
@@ -1233,8 +1235,6 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           Pca q;
           bool off_plane = false;  // q is the plane of the points off the flat's plane
           if (o.junction_ring_off_plane > 0) {
-            int32_t f0 = -1;
-            for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
             const Flat& F = seg.flats[size_t(f0)];
             for (const auto& [w, d] : rs.out) {
               const Vec3 p = M * S.x[w];

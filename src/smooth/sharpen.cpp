@@ -16,8 +16,8 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "core/sentinel.h"
 #include "core/predicates.h"
+#include "core/sentinel.h"
 #include "crease_fit.h"
 #include "quadric.h"
 #include "surface_graph.h"
@@ -1076,7 +1076,8 @@ struct Sharpener {
     const Plane& A = a_curved ? pb : pa;  // the flat's
     Plane B = a_curved ? pa : pb;         // the curved side's, moved
     for (uint32_t q : near)
-      if (depth(A, B, wrong(q)) > kWedgeSlack) B.c = kind > 0 ? std::min(B.c, B.n.dot(wrong(q))) : std::max(B.c, B.n.dot(wrong(q)));
+      if (depth(A, B, wrong(q)) > kWedgeSlack)
+        B.c = kind > 0 ? std::min(B.c, B.n.dot(wrong(q))) : std::max(B.c, B.n.dot(wrong(q)));
     for (uint32_t q : near) {  // the other samples stay on their sides of the moved plane
       const double d = B.n.dot(kind > 0 ? s.inside_sample(q) : s.outside_sample(q)) - B.c;
       if (kind > 0 ? d > kWedgeSlack : d < -kWedgeSlack) return false;
