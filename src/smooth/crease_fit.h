@@ -73,14 +73,20 @@ struct CurvedCrease {
   Plane chosen, other;  // tangent planes (index space, outward) at the new point: v's side's and the other side's
 };
 
+// What curved_crease_targets may do with a curved vertex.
+enum CreaseRole : uint8_t {
+  kCreaseFree = 0,  // a band vertex when its normal turns, else a side point
+  kCreaseSkip = 1,  // neither placed nor a side point (junctions, the flat crease zone)
+  kCreaseSide = 2,  // a side point only (a thin wall's vertex, on its fitted plane)
+};
+
 // The band vertices placed where their stick leaves the two sides' solid
 // (intersection of the quadrics' insides at a convex crease, union at a
-// concave one), in vertex order; region = flat id or -1 per vertex, skip =
-// vertices neither placed nor used as side points (junctions, the flat
-// crease zone), x = positions (index space), off / adj = vertex adjacency.
-// `normals` (optional) receives the physical vertex normals used.
+// concave one), in vertex order; region = flat id or -1 per vertex, role =
+// CreaseRole per vertex, x = positions (index space), off / adj = vertex
+// adjacency. `normals` (optional) receives the physical vertex normals used.
 std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
-                                                const std::vector<uint8_t>& skip, const std::vector<Vec3>& x,
+                                                const std::vector<uint8_t>& role, const std::vector<Vec3>& x,
                                                 const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
                                                 const CurvedCreaseFit& c, std::vector<Vec3>* normals = nullptr);
 

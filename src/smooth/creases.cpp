@@ -91,7 +91,7 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
 }
 
 std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
-                                                const std::vector<uint8_t>& skip, const std::vector<Vec3>& x,
+                                                const std::vector<uint8_t>& role, const std::vector<Vec3>& x,
                                                 const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
                                                 const CurvedCreaseFit& c, std::vector<Vec3>* normals) {
   const size_t n = region.size();
@@ -104,7 +104,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
   for (auto& v : vn) v = (Minv_t * v).normalized();
   std::vector<uint8_t> band(n, 0);
   for (size_t v = 0; v < n; ++v) {
-    if (region[v] >= 0 || skip[v]) continue;
+    if (region[v] >= 0 || role[v] != kCreaseFree) continue;
     double mx = 0;
     for (uint32_t k = off[v]; k < off[v + 1]; ++k)
       if (region[adj[k]] < 0) mx = std::max(mx, degrees_between(vn[v], vn[adj[k]]));
@@ -125,7 +125,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       rings_around(v, c.rings, off, adj, [&](uint32_t w) { return region[w] < 0; }, rs);
       P.clear();
       for (const auto& [w, d] : rs.out)
-        if (!band[w] && !skip[w]) P.push_back(w);
+        if (!band[w] && role[w] != kCreaseSkip) P.push_back(w);
       if (P.size() < 2 * kSidePoints) continue;
       // Two sides: 2-means on the normals, seeded by the normal farthest
       // from v's and the one farthest from that.
@@ -262,12 +262,13 @@ size_t fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const Fl
   std::vector<Vec3> x(n);
   tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
   fixed.resize(n, 0);
-  std::vector<uint8_t> skip(n);
-  for (size_t v = 0; v < n; ++v) skip[v] = fixed[v] || (!seg.junction.empty() && seg.junction[v]);
+  std::vector<uint8_t> role(n);
+  for (size_t v = 0; v < n; ++v)
+    role[v] = fixed[v] || (!seg.junction.empty() && seg.junction[v]) ? detail::kCreaseSkip : detail::kCreaseFree;
   detail::CurvedCreaseFit c;
   c.sharp_angle = o.junction_angle;
   c.margin = o.margin;
-  const auto found = detail::curved_crease_targets(s, seg.region, skip, x, off, adj, c);
+  const auto found = detail::curved_crease_targets(s, seg.region, role, x, off, adj, c);
   for (const auto& f : found) {
     s.t[f.v] = s.lower_inside(f.v) ? f.t : 1 - f.t;
     fixed[f.v] = 1;
