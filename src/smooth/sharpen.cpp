@@ -87,6 +87,7 @@ struct NewVertex {
   bool moves = false;             // has a target away from where it was inserted
   bool sharp = false;             // on a labelled sharp crease
   bool on_flats = false;          // its target lies on flats' planes only (not a curved side's fit)
+  double angle = 0;               // edge vertex: degrees between its two planes' normals
 };
 
 struct Sharpener {
@@ -1132,6 +1133,7 @@ struct Sharpener {
         if (den > 1e-12) u = std::clamp(num / den, 0.1, 0.9);
         start = xa + u * (xb - xa);
         const double angle = angle_deg(pa->n, pb->n);
+        v.angle = angle;
         v.sharp = angle >= o.sharp_angle;
         if (1 - pa->n.dot(pb->n) >= floor2) {
           v.target = solve_planes(pl, 2, start, floor2);
@@ -1444,8 +1446,16 @@ struct Sharpener {
       // allowed; those whose target lies on flats' planes only are retried
       // (neighbours' cut-back moves may unblock them) while any vertex still
       // advances, for up to kRounds more rounds. Targets from a curved
-      // side's fit are not pushed further: on the CAD part at 256^3 that
-      // put one vertex 1.6 voxels off (0.77 before).
+      // side's fit are not pushed further (on the CAD part at 256^3 that
+      // put one vertex 1.6 voxels off, 0.77 before), except on a sharp
+      // crease whose planes are within o.retry_right_angle of perpendicular:
+      // there most cut-back moves had been blocked by a fan triangle that
+      // a neighbour's later move no longer turns over (CAD part 128: 6-21
+      // sharp vertices per rotation ended 0.2-1.7 voxels short of the
+      // crease). Wider crease angles came from a leaning curved side's
+      // plane (fandisk 128: 115-125 degrees at a 90-degree crease, moved
+      // 0.8-0.9 voxel off the truth) or from a false crease on a fillet
+      // (CAD part 64: 60-85 degrees; docs/BENCHMARKS.md, Sharp edges).
       std::vector<std::pair<uint32_t, Vec3>> jobs;
       std::vector<uint8_t> retry;
       for (uint32_t v : leftovers) {
@@ -1456,7 +1466,7 @@ struct Sharpener {
         for (size_t i = 0; i < nv.size(); ++i)
           if (nv[i].moves && nv[i].corner == bool(corners)) {
             jobs.push_back({uint32_t(n + i), nv[i].target});
-            retry.push_back(nv[i].on_flats);
+            retry.push_back(nv[i].on_flats || (nv[i].sharp && std::abs(nv[i].angle - 90) <= o.retry_right_angle));
           }
       std::vector<uint8_t> done(jobs.size(), 0);
       // Neighbours that block each other (two vertices of one thin triangle)

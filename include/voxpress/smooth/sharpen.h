@@ -133,6 +133,11 @@ struct SharpenOptions {
   /// not, the curved side's plane moves onto the sample, or the new vertex
   /// stays where it was inserted (sample_wedge in sharpen.cpp).
   bool sample_wedges = true;
+  /// Beyond the paper: a new vertex's move onto a sharp crease whose two
+  /// planes meet within this many degrees of perpendicular keeps being
+  /// retried after the moves are cut back, like those onto flats' planes
+  /// only (run() in sharpen.cpp; negative: off).
+  double retry_right_angle = 10;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
   Progress* progress = nullptr;
