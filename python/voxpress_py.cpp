@@ -243,7 +243,8 @@ py::dict py_check(const PyMesh& m, const py::object& volume, const py::kwargs& k
   return d;
 }
 
-py::dict py_evaluate(const PyMesh& m, const std::string& truth, const py::object& volume, size_t samples) {
+py::dict py_evaluate(const PyMesh& m, const std::string& truth, const py::object& volume, size_t samples,
+                     bool quadrature) {
   ScalarVolume scalar;
   std::optional<BinaryVolume> b;
   if (!volume.is_none()) b = binary_argument(volume, py::dict(), &scalar);
@@ -253,6 +254,7 @@ py::dict py_evaluate(const PyMesh& m, const std::string& truth, const py::object
     const auto t = resolve_truth(truth, b ? &scalar : nullptr);
     EvalOptions o;
     o.samples = samples;
+    o.quadrature = quadrature;
     if (b) o.volume = &*b;
     e = voxpress::evaluate(m.mesh, *t, o);
   }
@@ -268,6 +270,8 @@ py::dict py_evaluate(const PyMesh& m, const std::string& truth, const py::object
   d["result_to_truth"] = distances(e.result_to_truth);
   d["truth_to_result"] = distances(e.truth_to_result);
   d["hausdorff"] = e.hausdorff;
+  if (e.result_to_truth_rule_rms) d["result_to_truth_rule_rms"] = *e.result_to_truth_rule_rms;
+  if (e.result_to_truth_rule_rms_vox) d["result_to_truth_rule_rms_vox"] = *e.result_to_truth_rule_rms_vox;
   d["normal_error_deg"] = e.normal_error_deg;
   d["volume_ratio"] = e.volume_ratio;
   if (b) {
@@ -394,5 +398,7 @@ PYBIND11_MODULE(_voxpress, m) {
   m.def("check", &py_check, py::arg("mesh"), py::arg("volume") = py::none(),
         "Closed, manifold, oriented, self-intersections; with a volume, every sample on its side.");
   m.def("evaluate", &py_evaluate, py::arg("mesh"), py::kw_only(), py::arg("truth") = "", py::arg("volume") = py::none(),
-        py::arg("samples") = 200000, "Distances to the true surface (as `voxpress eval`).");
+        py::arg("samples") = 200000, py::arg("quadrature") = false,
+        "Distances to the true surface (as `voxpress eval`; quadrature: also the 7-point rule's result -> truth "
+        "RMS).");
 }

@@ -133,18 +133,31 @@ TEST(Metrics, RotatedBoxMatchesQuadrature) {
   EXPECT_GT(e.normal_deg, 2.0 * 7 / 13);  // the 2-degree faces, plus creases
 }
 
-TEST(Metrics, ScaledSphereHasTheAnalyticDistanceAndVolume) {
-  // A projected sphere mesh of radius 1.05 R against the analytic sphere of radius R.
+// A sphere's midpoint mesh at 80^3 projected onto radius 1.05 R, and the
+// analytic sphere of radius R.
+struct GrownSphere {
+  GeneratedShape g;
+  Mesh mesh;
+  double R = 0;
+  std::unique_ptr<Truth> truth;
+};
+GrownSphere grown_sphere() {
   GenerateOptions o;
   o.res = 80;
-  const GeneratedShape g = generate_shape(ShapeKind::sphere, o);
-  Mesh m = to_mesh(extract_sticks(g.volume));
-  const double R = g.scale;
-  for (Vec3& p : m.positions) p = g.translation + 1.05 * R * (p - g.translation).normalized();
-  const auto truth = shape_truth(ShapeKind::sphere, R * Mat3::Identity(), g.translation);
+  GrownSphere s{generate_shape(ShapeKind::sphere, o), {}, 0, nullptr};
+  s.mesh = to_mesh(extract_sticks(s.g.volume));
+  s.R = s.g.scale;
+  for (Vec3& p : s.mesh.positions) p = s.g.translation + 1.05 * s.R * (p - s.g.translation).normalized();
+  s.truth = shape_truth(ShapeKind::sphere, s.R * Mat3::Identity(), s.g.translation);
+  return s;
+}
+
+TEST(Metrics, ScaledSphereHasTheAnalyticDistanceAndVolume) {
+  const GrownSphere s = grown_sphere();
+  const double R = s.R;
   EvalOptions eo;
-  eo.volume = &g.volume;
-  const EvalReport r = evaluate(m, *truth, eo);
+  eo.volume = &s.g.volume;
+  const EvalReport r = evaluate(s.mesh, *s.truth, eo);
   // Chords of the fine mesh lie slightly inside the sphere of radius 1.05 R.
   EXPECT_NEAR(r.result_to_truth.mean, 0.05 * R, 0.004 * R);
   EXPECT_NEAR(r.truth_to_result.max, 0.05 * R, 0.002 * R);
@@ -152,6 +165,31 @@ TEST(Metrics, ScaledSphereHasTheAnalyticDistanceAndVolume) {
   EXPECT_EQ(r.stick_vertices, 0u);  // projected vertices are off their sticks
   EXPECT_FALSE(r.stick_rms_vox.has_value());
   EXPECT_GT(*r.classification_violations, 0u);  // the grown sphere swallows outside samples
+}
+
+TEST(Metrics, QuadratureRmsAgreesWithTheSamplesAndIgnoresTheirSeed) {
+  // The 7-point rule on every triangle (EvalOptions::quadrature) estimates
+  // the same result -> truth RMS as the area samples, but from fixed points
+  // of each triangle: another sampling seed moves the samples' figure, not
+  // the rule's.
+  const GrownSphere s = grown_sphere();
+  const double R = s.R;
+  EvalOptions eo;
+  eo.volume = &s.g.volume;
+  eo.samples = 50000;
+  eo.self_intersections = false;
+  const EvalReport plain = evaluate(s.mesh, *s.truth, eo);
+  EXPECT_FALSE(plain.result_to_truth_rule_rms.has_value());
+  eo.quadrature = true;
+  const EvalReport a = evaluate(s.mesh, *s.truth, eo);
+  eo.seed = 2;
+  const EvalReport b = evaluate(s.mesh, *s.truth, eo);
+  ASSERT_TRUE(a.result_to_truth_rule_rms && a.result_to_truth_rule_rms_vox);
+  EXPECT_NEAR(*a.result_to_truth_rule_rms, a.result_to_truth.rms, 0.01 * a.result_to_truth.rms);
+  EXPECT_NEAR(*a.result_to_truth_rule_rms_vox, a.result_to_truth_vox.rms, 0.01 * a.result_to_truth_vox.rms);
+  EXPECT_NEAR(*a.result_to_truth_rule_rms, 0.05 * R, 0.004 * R);  // chords lie slightly inside radius 1.05 R
+  EXPECT_NE(a.result_to_truth.rms, b.result_to_truth.rms);
+  EXPECT_EQ(*a.result_to_truth_rule_rms, *b.result_to_truth_rule_rms);
 }
 
 TEST(Metrics, SharpRecallAndPrecisionMeasureLength) {
@@ -275,6 +313,7 @@ TEST(Metrics, DeterministicForAnyThreadCount) {
   EvalOptions eo;
   eo.volume = &g.volume;
   eo.samples = 30000;
+  eo.quadrature = true;
   EvalReport one, many;
   {
     tbb::task_arena arena(1);
@@ -288,6 +327,7 @@ TEST(Metrics, DeterministicForAnyThreadCount) {
   EXPECT_EQ(one.truth_to_result.mean, many.truth_to_result.mean);
   EXPECT_EQ(one.normal_error_deg, many.normal_error_deg);
   EXPECT_EQ(*one.stick_rms_vox, *many.stick_rms_vox);
+  EXPECT_EQ(*one.result_to_truth_rule_rms, *many.result_to_truth_rule_rms);
 }
 
 }  // namespace

@@ -139,10 +139,14 @@ def test_mesh_outputs_and_evaluation(tmp_path):
     mesh.save(str(tmp_path / "m.obj"))
     assert voxpress.read_mesh(str(tmp_path / "m.obj")).faces.shape == mesh.faces.shape
     e = voxpress.evaluate(mesh, volume=str(vol), samples=20000)
-    m0 = voxpress.evaluate(voxpress.press(data, spacing=lat.spacing, origin=lat.origin, direction=lat.direction,
-                                          method="taubin", iterations=0), volume=str(vol), samples=20000)
+    m0_mesh = voxpress.press(data, spacing=lat.spacing, origin=lat.origin, direction=lat.direction,
+                             method="taubin", iterations=0)
+    m0 = voxpress.evaluate(m0_mesh, volume=str(vol), samples=20000)
     assert e["classification_violations"] == 0
     assert e["result_to_truth_vox"]["rms"] < 0.5 * m0["result_to_truth_vox"]["rms"]
+    assert "result_to_truth_rule_rms" not in e
+    q = voxpress.evaluate(m0_mesh, volume=str(vol), samples=20000, quadrature=True)
+    assert abs(q["result_to_truth_rule_rms_vox"] - q["result_to_truth_vox"]["rms"]) < 0.03 * q["result_to_truth_vox"]["rms"]
 
 
 def rss_bytes():

@@ -8,7 +8,10 @@
 //     surface crosses that stick (the crossing nearest the vertex);
 //   * result -> truth and truth -> result distances (RMS, mean, max), both
 //     sides sampled uniformly by area (the result's vertices also count for
-//     the max), and the symmetric Hausdorff distance;
+//     the max), and the symmetric Hausdorff distance; optionally
+//     (EvalOptions::quadrature) result -> truth RMS integrated over every
+//     triangle by a 7-point rule, which, unlike the samples, does not move
+//     when the mesh changes elsewhere (comparing two nearly equal meshes);
 //   * area-weighted mean angle between the result's face normals and the
 //     true normal at the closest point (where that point lies on a crease,
 //     the normal of the incident true face best aligned with the result's);
@@ -47,6 +50,7 @@ struct EvalOptions {
   double sharp_match_vox = 0.5;           ///< voxels: a sharp curve point this close to the other set is matched
   const BinaryVolume* volume = nullptr;   ///< enables the stick metric, voxel units and classification
   bool self_intersections = true;         ///< check_mesh's expensive part
+  bool quadrature = false;                ///< also result -> truth RMS by a 7-point rule per triangle
   Progress* progress = nullptr;
 };
 
@@ -59,6 +63,9 @@ struct EvalReport {
   DistanceStats result_to_truth, truth_to_result, result_to_truth_vox, truth_to_result_vox;
   double hausdorff = 0;
   std::optional<double> hausdorff_vox;
+  /// Result -> truth RMS by the 7-point rule (Dunavant degree 5) on every
+  /// triangle, area-weighted (EvalOptions::quadrature); voxels with the volume.
+  std::optional<double> result_to_truth_rule_rms, result_to_truth_rule_rms_vox;
   double normal_error_deg = 0;  ///< area-weighted mean angle
   double volume_ratio = 0;
   std::optional<uint64_t> classification_violations;
