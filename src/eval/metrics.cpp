@@ -223,8 +223,9 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
         for (const auto& [u, v, w, weight] : rule) {
           const Vec3 x = u * A + v * B + w * C;
           const Vec3 d = truth.closest(x).point - x;
+          const double dv = vox(d);
           sp += weight * d.squaredNorm();
-          sv += weight * vox(d) * vox(d);
+          sv += weight * dv * dv;
         }
         part[c][0] += area;
         part[c][1] += area * sp;

@@ -26,8 +26,8 @@ namespace voxpress {
 namespace {
 
 using detail::degrees_between;
-using detail::Plane;
 using detail::kNone;
+using detail::Plane;
 constexpr double kPi = std::numbers::pi;
 constexpr int kBucket = 2;       // cells per side of the buckets of the local intersection test
 constexpr int kNearBlock = 4;    // cells per side of the blocks that decide which triangles it sees

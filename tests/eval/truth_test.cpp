@@ -97,8 +97,9 @@ TEST(Truth, SharpEdges) {
   double cad = 0;
   for (const auto& e : shape_truth(ShapeKind::cad_part, Mat3::Identity(), Vec3::Zero())->sharp_edges(30))
     cad += (e[1] - e[0]).norm();
-  const double expected = (1.4 + 3.6 + 1.0 + std::numbers::pi * 0.2) + (3.3 + 1.0 + std::numbers::pi * 0.2 + 1.4) + 1.4 + 2 * 0.15 * std::sqrt(2.0) +
-                          0.7 + 2 * 2 * std::numbers::pi * 0.18 + 2 * std::numbers::pi * 0.35;
+  const double expected = (1.4 + 3.6 + 1.0 + std::numbers::pi * 0.2) + (3.3 + 1.0 + std::numbers::pi * 0.2 + 1.4) +
+                          1.4 + 2 * 0.15 * std::sqrt(2.0) + 0.7 + 2 * 2 * std::numbers::pi * 0.18 +
+                          2 * std::numbers::pi * 0.35;
   EXPECT_NEAR(cad, expected, 1e-3);
 }
 

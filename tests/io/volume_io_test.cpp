@@ -146,8 +146,10 @@ TEST(VolumeIO, NrrdVariants) {
     data.push_back(char((x >> 8) & 0xff));
     data.push_back(char(x & 0xff));
   }
-  test::write_file(tmp.path("be.nrrd"), "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 2 2\nspacings: 0.5 2 -3\n"
-                                   "endian: big\nencoding: raw\n\n" + data);
+  test::write_file(tmp.path("be.nrrd"),
+                   "NRRD0004\ntype: short\ndimension: 3\nsizes: 2 2 2\nspacings: 0.5 2 -3\n"
+                   "endian: big\nencoding: raw\n\n" +
+                       data);
   ScalarVolume v = read_volume(tmp.path("be.nrrd"));
   EXPECT_EQ(v.value(2), 300);
   EXPECT_EQ(v.value(1), -2);
@@ -155,30 +157,35 @@ TEST(VolumeIO, NrrdVariants) {
   EXPECT_EQ(v.lattice.direction(2, 2), -1);
   // Detached header with a data file, and with a LIST of files.
   test::write_file(tmp.path("vol.raw"), std::string("\x01\x00\x01\x00\x00\x01\x00\x01", 8));
-  test::write_file(tmp.path("det.nhdr"), "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
-                                    "space: RAS\nspace directions: (1,0,0) (0,1,0) (0,0,1)\ndata file: vol.raw\n");
+  test::write_file(tmp.path("det.nhdr"),
+                   "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+                   "space: RAS\nspace directions: (1,0,0) (0,1,0) (0,0,1)\ndata file: vol.raw\n");
   v = read_volume(tmp.path("det.nhdr"));
   EXPECT_EQ(v.lattice.space, Space::RAS);
   EXPECT_EQ(binarize(v).count_inside(), 4u);
   test::write_file(tmp.path("s0.raw"), std::string("\x01\x00\x01\x00", 4));
   test::write_file(tmp.path("s1.raw"), std::string("\x00\x01\x00\x01", 4));
-  test::write_file(tmp.path("list.nhdr"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
-                                     "data file: LIST\ns0.raw\ns1.raw\n");
+  test::write_file(tmp.path("list.nhdr"),
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+                   "data file: LIST\ns0.raw\ns1.raw\n");
   v = read_volume(tmp.path("list.nhdr"));
   EXPECT_EQ(v.value(4), 0);
   EXPECT_EQ(v.value(5), 1);
   // Text encoding and gzip members concatenated.
-  test::write_file(tmp.path("txt.nrrd"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: text\n\n1.5 -2\n");
+  test::write_file(tmp.path("txt.nrrd"),
+                   "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 1 1\nencoding: text\n\n1.5 -2\n");
   v = read_volume(tmp.path("txt.nrrd"));
   EXPECT_EQ(v.value(0), 1.5);
   test::write_file(tmp.path("multi.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 1 1\nencoding: gzip\n\n" +
-                                          gzip(std::string("\x01\x02", 2)) + gzip(std::string("\x03\x04", 2)));
+                                               gzip(std::string("\x01\x02", 2)) + gzip(std::string("\x03\x04", 2)));
   v = read_volume(tmp.path("multi.nrrd"));
   EXPECT_EQ(v.value(3), 4);
   // LAS space becomes RAS (x mirrored).
-  test::write_file(tmp.path("las.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
-                                    "space: left-anterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n"
-                                    "space origin: (10,20,30)\n\n" + std::string(1, '\1'));
+  test::write_file(tmp.path("las.nrrd"),
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n"
+                   "space: left-anterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n"
+                   "space origin: (10,20,30)\n\n" +
+                       std::string(1, '\1'));
   v = read_volume(tmp.path("las.nrrd"));
   EXPECT_EQ(v.lattice.space, Space::RAS);
   EXPECT_EQ(v.lattice.origin, Vec3(-10, 20, 30));
@@ -196,9 +203,10 @@ TEST(VolumeIO, SlicerSegmentations) {
       "Segment2_ID:=Segment_3\nSegment2_Name:=vessel\nSegment2_LabelValue:=2\nSegment2_Layer:=1\n";
   // 4-D layered file: 2 layers first (list axis), then 2 x 1 x 1 samples.
   test::write_file(tmp.path("layers.seg.nrrd"),
-              "NRRD0004\ntype: unsigned char\ndimension: 4\nspace: left-posterior-superior\nsizes: 2 2 1 1\n"
-              "space directions: none (1,0,0) (0,1,0) (0,0,1)\nkinds: list domain domain domain\n"
-              "encoding: raw\nspace origin: (0,0,0)\n" + keys + "\n" + std::string("\x01\x02\x00\x01", 4));
+                   "NRRD0004\ntype: unsigned char\ndimension: 4\nspace: left-posterior-superior\nsizes: 2 2 1 1\n"
+                   "space directions: none (1,0,0) (0,1,0) (0,0,1)\nkinds: list domain domain domain\n"
+                   "encoding: raw\nspace origin: (0,0,0)\n" +
+                       keys + "\n" + std::string("\x01\x02\x00\x01", 4));
   const ScalarVolume v = read_volume(tmp.path("layers.seg.nrrd"));
   EXPECT_EQ(v.components, 2);
   ASSERT_EQ(v.segments.size(), 3u);
@@ -271,15 +279,17 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
     expect_input_error([&] { read_volume(tmp.path(name)); }, name, name.ends_with(".nii.gz") ? "corrupt" : "truncated");
   }
   // Header dimensions that do not match the data.
-  test::write_file(tmp.path("big.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
-                                        std::string(12, '\1'));
+  test::write_file(tmp.path("big.nrrd"),
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" + std::string(12, '\1'));
   expect_input_error([&] { read_volume(tmp.path("big.nrrd")); }, "big.nrrd", "does not match");
   test::write_file(tmp.path("gzbig.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n" +
-                                          gzip(std::string(12, '\1')));
+                                               gzip(std::string(12, '\1')));
   expect_input_error([&] { read_volume(tmp.path("gzbig.nrrd")); }, "gzbig.nrrd", "more than");
   // Absurd dimensions are refused before allocating (a gzip bomb in the making).
-  test::write_file(tmp.path("bomb.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 100000 100000 100000\n"
-                                     "encoding: gzip\n\n" + gzip(std::string(1000, '\0')));
+  test::write_file(tmp.path("bomb.nrrd"),
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 100000 100000 100000\n"
+                   "encoding: gzip\n\n" +
+                       gzip(std::string(1000, '\0')));
   try {
     read_volume(tmp.path("bomb.nrrd"));
     FAIL();
@@ -290,8 +300,9 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
   ReadOptions small;
   small.max_bytes = 1000;
   EXPECT_THROW(read_volume(tmp.path("t.nrrd"), small), LimitError);
-  test::write_file(tmp.path("over.nrrd"), "NRRD0004\ntype: double\ndimension: 3\nsizes: 4294967296 4294967296 4294967296\n"
-                                     "encoding: raw\n\n");
+  test::write_file(tmp.path("over.nrrd"),
+                   "NRRD0004\ntype: double\ndimension: 3\nsizes: 4294967296 4294967296 4294967296\n"
+                   "encoding: raw\n\n");
   EXPECT_THROW(read_volume(tmp.path("over.nrrd")), LimitError);
   test::write_file(tmp.path("neg.nrrd"), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 -2 2\nencoding: raw\n\n");
   expect_input_error([&] { read_volume(tmp.path("neg.nrrd")); }, "neg.nrrd", "invalid dimension");
