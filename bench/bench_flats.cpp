@@ -208,6 +208,8 @@ int main(int argc, char** argv) try {
   app.add_flag("!--no-stab-refit", fo.stab_refit, "Without the flats' stabbing refit (near-axis faces)");
   app.add_option("--merge-angle", fo.merge_angle, "Degrees: adjacent flats this close are merged when one plane stabs both (0: off)");
   app.add_option("--curved-gain", fo.curved_gain, "Flats' curvature test: refuse a flat a quadric out-stabs this many times (0: off)");
+  app.add_option("--rim-tangent-angle", fo.rim_tangent_angle,
+                 "Flats: degrees within which a curved side continuing a flat takes its rim back (0: off)");
   app.add_flag("!--no-crease-refit", fo.crease_refit, "Without the flats' crease refit (their creases' samples as constraints)");
   app.add_flag("!--no-center", fo.center_planes, "Final planes by least squares of the estimate, not centred in their feasible set");
   CLI11_PARSE(app, argc, argv);

@@ -39,6 +39,7 @@ nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
           {"frozen", seg.frozen_count()},
           {"junctions", st.junctions},
           {"barriers", st.barriers},
+          {"rim_released", st.rim_released},
           {"crease_vertices", st.crease_vertices},
           {"curved_crease_vertices", st.curved_crease_vertices},
           {"votes", st.votes},
@@ -47,7 +48,11 @@ nlohmann::json flats_json(const FlatSegmentation& seg, const FlatOptions& o) {
           {"cells_tried", st.tried},
           {"min_area_cells", o.min_area},
           {"junction_angle", o.junction_angle},
-          {"seconds", {{"estimate", st.seconds_estimate}, {"detect", st.seconds_detect}, {"junctions", st.seconds_junctions}, {"creases", st.seconds_creases}}}};
+          {"seconds",
+           {{"estimate", st.seconds_estimate},
+            {"detect", st.seconds_detect},
+            {"junctions", st.seconds_junctions},
+            {"creases", st.seconds_creases}}}};
 }
 
 nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {

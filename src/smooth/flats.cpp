@@ -57,6 +57,11 @@ constexpr double kSeedShare = 0.3;
 constexpr int kCurvedRings = 10;
 constexpr double kCurvedWindow = 30;
 constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
+constexpr uint32_t kRimJunctionRings = 2;      // rim members this close to a junction stay (rim_tangent_angle)
+// Cells: how far from the flat's plane the tangent side's fitted points must
+// rise for the rim to leave it (a fillet does; the rounded estimate along a
+// box's crease stays within ~0.6 and fits a quadric that looks tangent).
+constexpr double kRimFilletRise = 1.5;
 // Junction test: points whose middle PCA eigenvalue is below this share of
 // the largest are a row (their plane is arbitrary).
 constexpr double kThinRow = 0.15;
@@ -407,6 +412,7 @@ struct Detector {
   uint32_t stamp = 0;
 
   double cos_cone;
+  std::vector<uint8_t> rim;  // per vertex: added by a rim growth (not a core member)
   // A core vertex: its stick stabbed, its estimated vertex within tol of the
   // plane and its estimated normal within the cone of the plane's.
   // With `slack` > 0 the plane may miss the stick by up to that fraction of
@@ -439,6 +445,13 @@ struct Detector {
       begin = end;
       end = cluster.size();
     }
+  }
+
+  // The rim: the stabbed sticks within rim_rings of `cluster`, flagged.
+  void grow_rim(std::vector<uint32_t>& cluster, const Plane& P) {
+    const size_t before = cluster.size();
+    grow(cluster, 0, o.rim_rings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
+    for (size_t i = before; i < cluster.size(); ++i) rim[cluster[i]] = 1;
   }
 
   // A cluster from the voters of one accumulator cell; empty if rejected.
@@ -518,7 +531,7 @@ struct Detector {
     }
     ++stamp;  // restab marked its candidates: only the core may stay marked
     for (uint32_t v : core) mark[v] = stamp;
-    grow(core, 0, o.rim_rings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
+    grow_rim(core, P);
     return core;
   }
 
@@ -1032,7 +1045,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // ---- Greedy extraction, best cell first (lazy max-heap; ties by cell index).
   std::priority_queue<std::pair<uint32_t, int64_t>> heap;
   for (size_t c = 0; c < cell_key.size(); ++c) heap.push({cell_count[c], -int64_t(c)});
-  Detector det{S, o, seg.region, std::vector<uint32_t>(n, 0), 0, cos_cone};
+  Detector det{S, o, seg.region, std::vector<uint32_t>(n, 0), 0, cos_cone, std::vector<uint8_t>(n, 0)};
   ProgressCounter progress(o.progress, "flats", 0);
   const Mat3 M = s.lattice.index_to_physical_matrix();
   const Mat3 Minv_t = M.inverse().transpose();
@@ -1174,10 +1187,11 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             for (uint32_t v : members[f]) {
               seg.region[v] = -1;
               seg.t[v] = std::numeric_limits<double>::quiet_NaN();
+              det.rim[v] = 0;
             }
           ++det.stamp;
           for (uint32_t v : both) det.mark[v] = det.stamp;
-          det.grow(both, 0, o.rim_rings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
+          det.grow_rim(both, P);
           for (uint32_t v : both) seg.region[v] = int32_t(a);
           members[a] = std::move(both);
           members[b].clear();
@@ -1207,6 +1221,37 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   const double cos_j = std::cos(o.junction_angle * kPi / 180);
   const double cell = std::cbrt(std::abs(M.determinant()));
   tbb::enumerable_thread_specific<detail::RingScratch> scratch;
+  // Beyond the paper: whether the curved side of fresh vertex v continues
+  // flat f tangentially within `cos_max`: a quadric fitted to the fresh
+  // vertices kTangentRings away (on the estimate) fits within
+  // tangent_residual and its normal, where v projects onto the flat, is
+  // within that angle of the flat's. A fillet passes; at a true crease the
+  // estimate is rounded, so the fit is poor or its normal there leans. With
+  // min_rise > 0 the fitted points must also reach that many cells off the
+  // flat's plane.
+  const auto fresh = [&](uint32_t w) { return seg.region[w] < 0; };
+  auto tangent = [&](uint32_t v, int32_t f, double cos_max, double min_rise, detail::RingScratch& rs,
+                     std::vector<Vec3>& pts) {
+    detail::rings_around(v, kTangentRings[1], S.adj_off, S.adj, fresh, rs);
+    pts.clear();
+    Vec3 outward = Vec3::Zero();
+    for (const auto& [w, d] : rs.out)
+      if (d >= kTangentRings[0]) {
+        pts.push_back(M * S.x[w]);
+        outward += M * (S.outside(w) - S.inside(w));
+      }
+    detail::Quadric Q;
+    const Flat& F = seg.flats[size_t(f)];
+    if (min_rise > 0) {
+      double rise = 0;
+      for (const Vec3& p : pts) rise = std::max(rise, std::abs(F.normal.dot(p) - F.offset));
+      if (rise < min_rise * cell) return false;
+    }
+    if (!Q.fit(pts, outward) || Q.residual > o.tangent_residual * cell) return false;
+    const Vec3 p = M * S.x[v];
+    const Vec3 foot = p - (F.normal.dot(p) - F.offset) * F.normal;
+    return std::abs(Q.normal_at(foot).dot(F.normal)) >= cos_max;
+  };
   auto detect_junctions = [&] {
   std::fill(seg.junction.begin(), seg.junction.end(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -1218,7 +1263,6 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
         if (f0 < 0) continue;
         // Fresh vertices of the 2-ring (v included), in physical space.
-        const auto fresh = [&](uint32_t w) { return seg.region[w] < 0; };
         detail::rings_around(uint32_t(v), 2, S.adj_off, S.adj, fresh, rs);
         bool sharp = true;  // too few fresh vertices for a plane: squeezed between flats
         if (rs.out.size() >= 3) {
@@ -1261,28 +1305,11 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             // Beyond the paper: a curved face tangent to the flat (a
             // fillet) leans past the angle a couple of rings from the border
             // once the flat's rim has reached onto it. The estimate is not
-            // rounded there (there is no crease to round), so a quadric
-            // fitted to the curved side 2-6 rings away is good, and its
-            // normal where v projects onto the flat is the flat's: smooth.
-            // At a true crease the fit is bad (rounded estimate) or its
-            // normal there leans: sharp stays.
-            if (sharp && flat >= 0 && o.tangent_residual > 0) {
-              detail::rings_around(uint32_t(v), kTangentRings[1], S.adj_off, S.adj, fresh, rs);
-              pts.clear();
-              Vec3 outward = Vec3::Zero();
-              for (const auto& [w, d] : rs.out)
-                if (d >= kTangentRings[0]) {
-                  pts.push_back(M * S.x[w]);
-                  outward += M * (S.outside(w) - S.inside(w));
-                }
-              detail::Quadric Q;
-              const Flat& F = seg.flats[size_t(flat)];
-              if (Q.fit(pts, outward) && Q.residual <= o.tangent_residual * cell) {
-                const Vec3 p = M * S.x[v];
-                const Vec3 foot = p - (F.normal.dot(p) - F.offset) * F.normal;
-                if (std::abs(Q.normal_at(foot).dot(F.normal)) >= cos_j) sharp = false;
-              }
-            }
+            // rounded there (there is no crease to round), so the tangent
+            // test's quadric is good and its normal at the flat is the
+            // flat's: smooth.
+            if (sharp && flat >= 0 && o.tangent_residual > 0 && tangent(uint32_t(v), flat, cos_j, 0, rs, pts))
+              sharp = false;
           }
         }
         seg.junction[v] = sharp;
@@ -1356,6 +1383,62 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     stale = !moves.empty();
   }
   if (stale) detect_junctions();
+  // Beyond the paper: the rim leaves the tangent fillets. The rim takes the
+  // stabbed sticks two rings past the core so that a flat reaches its
+  // creases, where the estimate was rounded; at a smooth border onto a
+  // curved face tangent to the flat it runs onto that face instead, where a
+  // plane stabs sticks as long as the face stays within a stick of it, and
+  // freezes them up to ~0.4 cell off the truth (a 6-cell fillet two cells
+  // past its foot). There the rim's members next to the border (one ring)
+  // go back to the curved side, unless a junction is within two rings (the
+  // rim is the flat's reach to that crease).
+  if (o.rim_tangent_angle > 0 && !seg.flats.empty()) {
+    const double cos_t = std::cos(o.rim_tangent_angle * kPi / 180);
+    std::vector<uint32_t> near_junction(n, detail::kUnreached), near_tangent(n, detail::kUnreached), junctions, borders;
+    for (uint32_t v = 0; v < n; ++v) {
+      if (seg.region[v] >= 0) continue;
+      if (seg.junction[v]) {
+        near_junction[v] = 0;
+        junctions.push_back(v);
+        continue;
+      }
+      int32_t f0 = -1;  // v's first flat neighbour: v is on a smooth border
+      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
+      if (f0 >= 0) borders.push_back(v);
+    }
+    // The smooth borders that are tangent (in parallel; each test reads the
+    // regions only).
+    std::vector<uint8_t> is_tangent(borders.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, borders.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+      std::vector<Vec3> pts;
+      detail::RingScratch& rs = scratch.local();
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        const uint32_t v = borders[i];
+        int32_t f0 = -1;
+        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
+        is_tangent[i] = tangent(v, f0, cos_t, kRimFilletRise, rs, pts);
+      }
+    });
+    std::vector<uint32_t> tangent_borders;
+    for (size_t i = 0; i < borders.size(); ++i)
+      if (is_tangent[i]) {
+        near_tangent[borders[i]] = 0;
+        tangent_borders.push_back(borders[i]);
+      }
+    const auto any = [](uint32_t, uint32_t) { return true; };
+    detail::spread_rings(std::move(junctions), 0, kRimJunctionRings, S.adj_off, S.adj, near_junction, any);
+    detail::spread_rings(std::move(tangent_borders), 0, 1, S.adj_off, S.adj, near_tangent, any);
+    size_t released = 0;
+    for (uint32_t v = 0; v < n; ++v)
+      if (seg.region[v] >= 0 && det.rim[v] && near_tangent[v] != detail::kUnreached &&
+          near_junction[v] == detail::kUnreached) {
+        seg.region[v] = -1;
+        seg.t[v] = std::numeric_limits<double>::quiet_NaN();
+        ++released;
+      }
+    seg.stats.rim_released = released;
+    if (released > 0) detect_junctions();
+  }
   // Sizes, once the extension has settled the members. Index-space area ->
   // physical: |det M| |M^-T n| for a plane of unit index normal n.
   for (Flat& f : seg.flats) f.sticks = 0, f.area_cells = 0;

@@ -164,6 +164,20 @@ double fraction_within(const std::vector<double>& sorted, double r) {
   return double(std::upper_bound(sorted.begin(), sorted.end(), r) - sorted.begin()) / double(sorted.size());
 }
 
+FlatOptions paper_junctions() {
+  FlatOptions fo;
+  fo.junction_ring_off_plane = 0;
+  return fo;
+}
+
+// The flats with their whole rims (FlatOptions::rim_tangent_angle off): the
+// tests of steps measured before the rim left the tangent fillets, whose
+// figures it moves, compare their two arms on these.
+FlatOptions full_rims(FlatOptions fo = {}) {
+  fo.rim_tangent_angle = 0;
+  return fo;
+}
+
 TEST(Sharpen, ThinStripsAndTangentPlanesPlaceTheCreases) {
   // The CAD part at 128^3 (voxel = unit spacing, so distances are in
   // voxels). Where the flats' rims stop a few vertices short of a crease
@@ -188,7 +202,7 @@ TEST(Sharpen, ThinStripsAndTangentPlanesPlaceTheCreases) {
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
     const GeneratedShape g = shape(ShapeKind::cad_part, 128, seed);
     const auto truth = shape_truth(ShapeKind::cad_part, g.linear, g.translation)->sharp_edges(30);
-    const Sharpened a = run(g.volume, {}, {}, paper), b = run(g.volume, {}, {}, strips);
+    const Sharpened a = run(g.volume, full_rims(), {}, paper), b = run(g.volume, full_rims(), {}, strips);
     expect_valid(b.after, g.volume);
     const auto da = crease_distances(truth, a.after), db = crease_distances(truth, b.after);
     const double h_paper = std::max(da.back(), labelled_distances(truth, a.after).back());
@@ -197,7 +211,7 @@ TEST(Sharpen, ThinStripsAndTangentPlanesPlaceTheCreases) {
     gain = std::max(gain, h_paper - h_strips);
     if (seed < 2 || seed > 3) continue;
     // Tangent planes: more of the creases within 0.15 voxel of a label.
-    const Sharpened c = run(g.volume);
+    const Sharpened c = run(g.volume, full_rims());
     expect_valid(c.after, g.volume);
     EXPECT_GT(fraction_within(crease_distances(truth, c.after), 0.15), fraction_within(db, 0.15) + 0.03);
     EXPECT_GT(c.stats.tangent_planes, 100u);
@@ -250,12 +264,6 @@ struct Case {
 // junction_ring_off_plane off): the steps below that were measured with it
 // are tested with it, since the stopped-rim test now does part of their
 // work on their seeds.
-FlatOptions paper_junctions() {
-  FlatOptions fo;
-  fo.junction_ring_off_plane = 0;
-  return fo;
-}
-
 // The case pressed with flats once and sharpened twice: with `off` (one
 // step turned off) and with the defaults.
 struct OffOn {
@@ -314,7 +322,7 @@ TEST(Sharpen, FinalCreaseFitPlacesTheRoundedCreases) {
   double within_off = 0, within_on = 0, rms_off = 0, rms_on = 0;
   for (const Case c : {Case{ShapeKind::cylinder, 1}, Case{ShapeKind::cylinder, 4}, Case{ShapeKind::cad_part, 4}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
-    const auto [g, a, b] = sharpen_off_on(c, off);
+    const auto [g, a, b] = sharpen_off_on(c, off, {}, full_rims());
     const auto truth = shape_truth(c.kind, g.linear, g.translation);
     EXPECT_EQ(a.stats.final_crease_vertices, 0u);
     EXPECT_GT(b.stats.final_crease_vertices, 100u);
@@ -411,7 +419,7 @@ TEST(Sharpen, OnPlaneBandsJoinTheirFlat) {
   double rms_off = 0, rms_on = 0;
   for (const int seed : {3, 4, 13}) {
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
-    const auto [g, a, b] = sharpen_off_on({ShapeKind::cad_part, seed}, off, {}, paper_junctions());
+    const auto [g, a, b] = sharpen_off_on({ShapeKind::cad_part, seed}, off, {}, full_rims(paper_junctions()));
     const auto truth = shape_truth(ShapeKind::cad_part, g.linear, g.translation);
     const auto sharp = truth->sharp_edges(30);
     EXPECT_EQ(a.stats.band_joins + a.stats.band_junctions, 0u);
@@ -474,7 +482,7 @@ TEST(Sharpen, OnPlaneBandsReachTwoRingDeepNotches) {
   one.band_reach = 1;
   for (const Case c : {Case{ShapeKind::cylinder, 3}, Case{ShapeKind::cad_part, 22}}) {
     SCOPED_TRACE(std::string(shape_name(c.kind)) + " 128 seed " + std::to_string(c.seed));
-    const auto [g, a, b] = sharpen_off_on(c, one, {}, paper_junctions());
+    const auto [g, a, b] = sharpen_off_on(c, one, {}, full_rims(paper_junctions()));
     const auto truth = shape_truth(c.kind, g.linear, g.translation);
     const auto sharp = truth->sharp_edges(30);
     EXPECT_GT(b.stats.band_joins, a.stats.band_joins);
@@ -503,7 +511,7 @@ TEST(Sharpen, JunctionTestLeavesTheStoppedRimOut) {
     const GeneratedShape g = shape(c.kind, 128, c.seed);
     const auto truth = shape_truth(c.kind, g.linear, g.translation);
     const auto sharp = truth->sharp_edges(30);
-    const Sharpened a = run(g.volume, paper_junctions()), b = run(g.volume);
+    const Sharpened a = run(g.volume, full_rims(paper_junctions())), b = run(g.volume, full_rims());
     expect_valid(b.after, g.volume);
     const auto ca = crease_distances(sharp, a.after), cb = crease_distances(sharp, b.after);
     const double ra = eval(a.after, *truth, g.volume).result_to_truth_vox.rms;

@@ -40,7 +40,9 @@
 //     (docs/ARCHITECTURE.md).
 //  5. Rim. The flat finally takes the stabbed sticks within `rim_rings`
 //     surface edges of its core, so it reaches its edges, where the estimate
-//     was rounded.
+//     was rounded. Beyond the paper, once the junctions are known, the rim
+//     is taken back next to smooth borders onto a tangent curved face
+//     (`rim_tangent_angle`), where it had run onto a fillet.
 //  6. Merge (beyond the paper). Two adjacent flats whose normals are within
 //     `merge_angle` become one when a single plane stabs both cores and 90 %
 //     of their members (one face the growth took in two pieces).
@@ -103,6 +105,12 @@ struct FlatOptions {
   double max_spread = 1.4;     ///< degrees: largest median angle between a core normal and the plane's
   double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
   int rim_rings = 2;           ///< surface rings added around the core
+  /// Beyond the paper: at a smooth border whose curved side continues the
+  /// flat within this many degrees (the tangent test's quadric, 2-6 rings
+  /// away), the rim's members next to the border are given back to the
+  /// curved side unless a junction is within 2 rings: the rim ran onto a
+  /// fillet there, not up to a crease (0: off).
+  double rim_tangent_angle = 15;
   double merge_angle = 4;      ///< degrees: adjacent flats this close are merged when one plane stabs both (0: off)
   /// Beyond the paper: refit each core's plane by the count of sticks it
   /// stabs around it, not by the estimate (faces near a lattice axis, whose
@@ -161,6 +169,7 @@ struct Flat {
 struct FlatStats {
   size_t votes = 0, voters = 0, cells = 0, tried = 0;
   size_t junctions = 0, barriers = 0;
+  size_t rim_released = 0;  ///< rim members given back to a tangent curved side (rim_tangent_angle; last pass)
   double seconds_estimate = 0, seconds_detect = 0, seconds_junctions = 0;
   size_t crease_vertices = 0;  ///< vertices fit_creases placed (last round)
   size_t curved_crease_vertices = 0;  ///< vertices fit_curved_creases placed (last round)
