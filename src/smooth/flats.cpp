@@ -1389,12 +1389,15 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // curved face tangent to the flat it runs onto that face instead, where a
   // plane stabs sticks as long as the face stays within a stick of it, and
   // freezes them up to ~0.4 cell off the truth (a 6-cell fillet two cells
-  // past its foot). There the rim's members next to the border (one ring)
-  // go back to the curved side, unless a junction is within two rings (the
-  // rim is the flat's reach to that crease).
+  // past its foot). Where the curved side passes the tangent test within
+  // rim_tangent_angle and rises kRimFilletRise off the plane, the rim's
+  // members next to the border (one ring) go back to the curved side, unless
+  // a junction is within two rings (the rim is the flat's reach to that
+  // crease).
   if (o.rim_tangent_angle > 0 && !seg.flats.empty()) {
     const double cos_t = std::cos(o.rim_tangent_angle * kPi / 180);
-    std::vector<uint32_t> near_junction(n, detail::kUnreached), near_tangent(n, detail::kUnreached), junctions, borders;
+    std::vector<uint32_t> near_junction(n, detail::kUnreached), near_tangent(n, detail::kUnreached), junctions;
+    std::vector<std::pair<uint32_t, int32_t>> borders;  // a smooth border's fresh vertex and its first flat neighbour
     for (uint32_t v = 0; v < n; ++v) {
       if (seg.region[v] >= 0) continue;
       if (seg.junction[v]) {
@@ -1402,9 +1405,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         junctions.push_back(v);
         continue;
       }
-      int32_t f0 = -1;  // v's first flat neighbour: v is on a smooth border
+      int32_t f0 = -1;
       for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
-      if (f0 >= 0) borders.push_back(v);
+      if (f0 >= 0) borders.push_back({v, f0});
     }
     // The smooth borders that are tangent (in parallel; each test reads the
     // regions only).
@@ -1412,18 +1415,14 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     tbb::parallel_for(tbb::blocked_range<size_t>(0, borders.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
       std::vector<Vec3> pts;
       detail::RingScratch& rs = scratch.local();
-      for (size_t i = r.begin(); i < r.end(); ++i) {
-        const uint32_t v = borders[i];
-        int32_t f0 = -1;
-        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
-        is_tangent[i] = tangent(v, f0, cos_t, kRimFilletRise, rs, pts);
-      }
+      for (size_t i = r.begin(); i < r.end(); ++i)
+        is_tangent[i] = tangent(borders[i].first, borders[i].second, cos_t, kRimFilletRise, rs, pts);
     });
     std::vector<uint32_t> tangent_borders;
     for (size_t i = 0; i < borders.size(); ++i)
       if (is_tangent[i]) {
-        near_tangent[borders[i]] = 0;
-        tangent_borders.push_back(borders[i]);
+        near_tangent[borders[i].first] = 0;
+        tangent_borders.push_back(borders[i].first);
       }
     const auto any = [](uint32_t, uint32_t) { return true; };
     detail::spread_rings(std::move(junctions), 0, kRimJunctionRings, S.adj_off, S.adj, near_junction, any);
