@@ -474,7 +474,9 @@ TEST(Flats, RimLeavesTangentFillets) {
   // to the truth, and the labels closer to the true creases. The box has
   // no fillet: nothing is released (the rounded estimate along its creases
   // stays within a cell of the planes).
-  for (int seed : {18, 24}) {
+  // One rotation (CI time; seed 18 measured 0.02135 -> 0.01906 and 0.573 ->
+  // 0.448 too).
+  for (int seed : {24}) {
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
     const GeneratedShape g = rotated(ShapeKind::cad_part, 128, seed);
     Mesh tm = cad_part_mesh();
@@ -502,8 +504,8 @@ TEST(Flats, RimLeavesTangentFillets) {
     const Out off = measure(0), on = measure(FlatOptions{}.rim_tangent_angle);
     EXPECT_EQ(off.released, 0u);
     EXPECT_GT(on.released, 100u);
-    EXPECT_LT(on.rms, 0.95 * off.rms) << "measured 0.02135 -> 0.01906, 0.02245 -> 0.01955";
-    EXPECT_LT(on.hausdorff, 0.9 * off.hausdorff) << "measured 0.573 -> 0.448, 0.611 -> 0.276 voxel";
+    EXPECT_LT(on.rms, 0.95 * off.rms) << "measured 0.02245 -> 0.01955";
+    EXPECT_LT(on.hausdorff, 0.9 * off.hausdorff) << "measured 0.611 -> 0.276 voxel";
   }
   for (int seed : {1, 2}) {
     SCOPED_TRACE("box 64 seed " + std::to_string(seed));
