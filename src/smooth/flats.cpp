@@ -1230,6 +1230,12 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // min_rise > 0 the fitted points must also reach that many cells off the
   // flat's plane.
   const auto fresh = [&](uint32_t w) { return seg.region[w] < 0; };
+  // The flat of v's first frozen neighbour, or -1.
+  const auto first_flat = [&](size_t v) {
+    int32_t f0 = -1;
+    for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
+    return f0;
+  };
   auto tangent = [&](uint32_t v, int32_t f, double cos_max, double min_rise, detail::RingScratch& rs,
                      std::vector<Vec3>& pts) {
     detail::rings_around(v, kTangentRings[1], S.adj_off, S.adj, fresh, rs);
@@ -1259,8 +1265,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       detail::RingScratch& rs = scratch.local();
       for (size_t v = r.begin(); v < r.end(); ++v) {
         if (seg.region[v] >= 0) continue;
-        int32_t f0 = -1;  // v's first flat neighbour
-        for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
+        const int32_t f0 = first_flat(v);
         if (f0 < 0) continue;
         // Fresh vertices of the 2-ring (v included), in physical space.
         detail::rings_around(uint32_t(v), 2, S.adj_off, S.adj, fresh, rs);
@@ -1405,9 +1410,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         junctions.push_back(v);
         continue;
       }
-      int32_t f0 = -1;
-      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && f0 < 0; ++k) f0 = seg.region[S.adj[k]];
-      if (f0 >= 0) borders.push_back({v, f0});
+      if (const int32_t f0 = first_flat(v); f0 >= 0) borders.push_back({v, f0});
     }
     // The smooth borders that are tangent (in parallel; each test reads the
     // regions only).
