@@ -133,6 +133,18 @@ struct Sharpener {
     const double hi = normal.dot(s.inside_sample(v)) - c, ho = normal.dot(s.outside_sample(v)) - c;
     return ho > hi ? -hi / (ho - hi) : std::numeric_limits<double>::quiet_NaN();
   }
+  // Where along v's stick (0 inside, 1 outside sample) it leaves the
+  // half-space below `p`: its crossing when it runs outwards through the
+  // plane; +inf when the whole stick lies below a plane it does not climb
+  // (it never leaves), -inf when it lies wholly above one (it is never
+  // in); NaN when it enters the half-space on its way out.
+  double leaves_at(uint32_t v, const Plane& p) const {
+    const double hi = p.n.dot(s.inside_sample(v)) - p.c, ho = p.n.dot(s.outside_sample(v)) - p.c;
+    if (ho > hi) return -hi / (ho - hi);
+    if (hi < 0) return INFINITY;
+    if (ho > 0) return -INFINITY;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   double flat_crossing(uint32_t v, int32_t f) const {
     return stick_crossing(v, seg.flats[size_t(f)].index_normal, seg.flats[size_t(f)].index_offset);
   }
@@ -866,12 +878,13 @@ struct Sharpener {
   // concave one (crease_kind_near). Decided for all first, then applied.
   //  * A curved junction vertex whose stick leaves that solid on the flat's
   //    plane joins the flat there (a slide along the stick: no sample
-  //    changes side). A stick nearly parallel to the flat may not cross its
-  //    plane at all (CAD part 128 seed 13: two curved vertices at a sample
-  //    1.3 voxels from the crease, the chain looping out to them): when the
-  //    vertex lies within kPastSample of the flat's plane and more than that
-  //    inside the side's half-space (outside at a concave crease), it joins
-  //    where it is.
+  //    changes side). A stick that never climbs the side's plane and lies
+  //    below it leaves the solid on the flat's plane (leaves_at: CAD part
+  //    128 seed 10, a curved junction at a sample 0.76 voxel from the
+  //    crease; left curved, the chain detoured 0.85 voxel around it). A stick nearly parallel to the flat may not cross
+  //    its plane at all (CAD part 128 seed 13: two curved vertices at a sample 1.3 voxels from the crease, the chain
+  //    looping out to them): when the vertex lies within kPastSample of the flat's plane and more than that inside the
+  //    side's half-space (outside at a concave crease), it joins where it is.
   //  * A flat member next to a curved junction, whose side's tangent plane
   //    meets the flat at sharp_angle or more, leaves the flat when its stick
   //    leaves the solid on that tangent plane at least kLeaveMargin before
@@ -899,8 +912,8 @@ struct Sharpener {
         if (!tangent_plane(v, side)) continue;
         const int kind = crease_kind_near(v, f, ring);
         if (crossed) {
-          const double tc = stick_crossing(v, side.n, side.c);
-          if (std::isfinite(tc) && ((kind > 0 && tf < tc) || (kind < 0 && tf > tc))) moves.push_back({v, f, tf});
+          const double tc = leaves_at(v, side);
+          if ((kind > 0 && tf < tc) || (kind < 0 && tf > tc)) moves.push_back({v, f, tf});
         } else {
           const double hc = side.n.dot(x[v]) - side.c;  // on the flat's plane already: where is the side's?
           if ((kind > 0 && hc < -kPastSample) || (kind < 0 && hc > kPastSample)) moves.push_back({v, f, NAN});
@@ -1195,6 +1208,26 @@ struct Sharpener {
           c.target = solve_planes(pl, 3, start, floor2);
           c.moves = (c.target - start).norm() <= o.max_move;
           if (!c.moves) c.target = start;
+        }
+        // Beyond the paper: where a corner's third plane is missing (a
+        // curved junction without a fit of its own, squeezed between two
+        // flats), it goes onto the line of the other two; left at the
+        // centroid, its three labelled edges made a spur off the crease
+        // (CAD part 128 seed 128: 0.67 voxel off a crease of two flats).
+        // Where all three planes meet too far away it stays: the line of
+        // two flats then runs on past the end of their crease (seed 26:
+        // 0.59 -> 0.66 voxel from any true crease had it moved there).
+        if (!c.moves && (p[0] != nullptr) + (p[1] != nullptr) + (p[2] != nullptr) == 2) {
+          const int i = p[0] ? 0 : 1, j = p[2] ? 2 : 1;
+          if (1 - std::abs(p[i]->n.dot(p[j]->n)) >= floor2) {
+            const Plane pl[2] = {*p[i], *p[j]};
+            const Vec3 q = solve_planes(pl, 2, start, floor2);
+            if ((q - start).norm() <= o.max_move) {
+              c.target = q;
+              c.moves = true;
+              c.on_flats = label[t[size_t(i)]] >= 0 && label[t[size_t(j)]] >= 0;
+            }
+          }
         }
         if (!c.moves) ++st.fallbacks;
         c.sharp = true;
