@@ -1303,13 +1303,13 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             const Vec3 ns = q.normal;
             // The neighbouring flats the plane leans past the angle from.
             std::array<int32_t, 4> leaning{};
-            size_t count = 0;
+            size_t leaning_count = 0;
             for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) {
               const int32_t f = seg.region[S.adj[k]];
               if (f < 0 || std::abs(ns.dot(seg.flats[size_t(f)].normal)) >= cos_j) continue;
-              if (std::find(leaning.begin(), leaning.begin() + count, f) == leaning.begin() + count &&
-                  count < leaning.size())
-                leaning[count++] = f;
+              if (std::find(leaning.begin(), leaning.begin() + leaning_count, f) == leaning.begin() + leaning_count &&
+                  leaning_count < leaning.size())
+                leaning[leaning_count++] = f;
             }
             // Beyond the paper: a curved face tangent to the flat (a
             // fillet) leans past the angle a couple of rings from the border
@@ -1322,7 +1322,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             // vertex; judging the tangent one alone left a gap in the
             // other's crease, 0.72 voxel from any label).
             sharp = false;
-            for (size_t i = 0; i < count && !sharp; ++i)
+            for (size_t i = 0; i < leaning_count && !sharp; ++i)
               sharp = !(o.tangent_residual > 0 && tangent(uint32_t(v), leaning[i], cos_j, 0, rs, pts));
           }
         }
