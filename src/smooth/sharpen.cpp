@@ -126,24 +126,23 @@ struct Sharpener {
   double height(int32_t f, const Vec3& p) const {
     return seg.flats[size_t(f)].index_normal.dot(p) - seg.flats[size_t(f)].index_offset;
   }
-  // Where the plane normal . p = c crosses v's stick from its inside sample
-  // (t = 0) to its outside one (t = 1), unclamped; NaN when it is not
-  // crossed outwards.
-  double stick_crossing(uint32_t v, const Vec3& normal, double c) const {
-    const double hi = normal.dot(s.inside_sample(v)) - c, ho = normal.dot(s.outside_sample(v)) - c;
-    return ho > hi ? -hi / (ho - hi) : std::numeric_limits<double>::quiet_NaN();
-  }
   // Where along v's stick (0 inside, 1 outside sample) it leaves the
-  // half-space below `p`: its crossing when it runs outwards through the
-  // plane; +inf when the whole stick lies below a plane it does not climb
-  // (it never leaves), -inf when it lies wholly above one (it is never
-  // in); NaN when it enters the half-space on its way out.
+  // half-space below `p`: its crossing (unclamped) when it runs outwards
+  // through the plane; +inf when the whole stick lies below a plane it does
+  // not climb (it never leaves), -inf when it lies wholly above one (it is
+  // never in); NaN when it enters the half-space on its way out.
   double leaves_at(uint32_t v, const Plane& p) const {
     const double hi = p.n.dot(s.inside_sample(v)) - p.c, ho = p.n.dot(s.outside_sample(v)) - p.c;
     if (ho > hi) return -hi / (ho - hi);
     if (hi < 0) return INFINITY;
     if (ho > 0) return -INFINITY;
     return std::numeric_limits<double>::quiet_NaN();
+  }
+  // Where the plane normal . p = c crosses v's stick outwards (leaves_at's
+  // crossing); NaN when it is not crossed outwards.
+  double stick_crossing(uint32_t v, const Vec3& normal, double c) const {
+    const double t = leaves_at(v, Plane{normal, c});
+    return std::isfinite(t) ? t : std::numeric_limits<double>::quiet_NaN();
   }
   double flat_crossing(uint32_t v, int32_t f) const {
     return stick_crossing(v, seg.flats[size_t(f)].index_normal, seg.flats[size_t(f)].index_offset);
@@ -881,10 +880,13 @@ struct Sharpener {
   //    changes side). A stick that never climbs the side's plane and lies
   //    below it leaves the solid on the flat's plane (leaves_at: CAD part
   //    128 seed 10, a curved junction at a sample 0.76 voxel from the
-  //    crease; left curved, the chain detoured 0.85 voxel around it). A stick nearly parallel to the flat may not cross
-  //    its plane at all (CAD part 128 seed 13: two curved vertices at a sample 1.3 voxels from the crease, the chain
-  //    looping out to them): when the vertex lies within kPastSample of the flat's plane and more than that inside the
-  //    side's half-space (outside at a concave crease), it joins where it is.
+  //    crease; left curved, the chain detoured 0.85 voxel around it). A
+  //    stick nearly parallel to the flat may not cross its plane at all
+  //    (CAD part 128 seed 13: two curved vertices at a sample 1.3 voxels
+  //    from the crease, the chain looping out to them): when the vertex
+  //    lies within kPastSample of the flat's plane and more than that
+  //    inside the side's half-space (outside at a concave crease), it joins
+  //    where it is.
   //  * A flat member next to a curved junction, whose side's tangent plane
   //    meets the flat at sharp_angle or more, leaves the flat when its stick
   //    leaves the solid on that tangent plane at least kLeaveMargin before
