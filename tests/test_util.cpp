@@ -181,6 +181,21 @@ BinaryVolume checkerboard(std::array<int64_t, 3> d, int period_axes) {
   return v;
 }
 
+Mesh rounded_to_float32(Mesh m) {
+  for (Vec3& p : m.positions) p = p.cast<float>().cast<double>();
+  return m;
+}
+
+void expect_guarantees(const Mesh& m, const BinaryVolume& v) {
+  const Mesh f = rounded_to_float32(m);
+  for (const Mesh* mesh : {&m, &f}) {
+    SCOPED_TRACE(mesh == &m ? "double" : "float32");
+    const MeshCheck mc = check_mesh(*mesh);
+    EXPECT_TRUE(mc.ok()) << (mc.problems.empty() ? "" : mc.problems[0]);
+    EXPECT_EQ(check_classification(*mesh, v).violations, 0u);
+  }
+}
+
 std::vector<Case> property_volumes() {
   std::vector<Case> out;
   Rng rng(2024);

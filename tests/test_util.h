@@ -84,6 +84,13 @@ struct Case {
 /// generated volumes (also reused by later methods' property tests).
 std::vector<Case> property_volumes();
 
+/// The mesh with its positions rounded to float32, as STL and glTF store
+/// them and as most viewers load PLY.
+Mesh rounded_to_float32(Mesh m);
+/// What the user gets, in double and after float32 rounding: closed,
+/// 2-manifold, oriented, no self-intersection, every sample of `v` on its side.
+void expect_guarantees(const Mesh& m, const BinaryVolume& v);
+
 /// Writes bytes to a file (test inputs).
 void write_file(const std::string& path, const std::string& bytes);
 

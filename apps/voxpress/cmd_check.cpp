@@ -13,6 +13,8 @@ struct CheckCmd {
 };
 
 void run_check(const CheckCmd& c, const Global& g) {
+  check_paths({c.mesh, c.volume}, {{c.json, OutputKind::json}});
+
   const Mesh mesh = read_mesh(c.mesh, {g.memory_limit()});
   MeshCheckOptions mo;
   mo.self_intersections = !c.no_self_intersections;
@@ -61,6 +63,7 @@ void run_check(const CheckCmd& c, const Global& g) {
   j["ok"] = ok;
   if (!c.json.empty()) write_json(c.json, j);
   std::printf("verdict     %s\n", ok ? "OK" : "FAILED");
+  OutputGroup::commit_open();  // the report of a failed check is delivered
   if (!ok) throw InputError(c.mesh, "the mesh failed its checks");
 }
 

@@ -23,6 +23,8 @@ nlohmann::json stats_json(const DistanceStats& s) {
 }
 
 void run_eval(const EvalCmd& c, const Global& g) {
+  check_paths({c.result, c.truth, c.volume}, {{c.json, OutputKind::json}});
+
   Stopwatch clock;
   const Mesh result = read_mesh(c.result, {g.memory_limit()});
   std::optional<ScalarVolume> raw;

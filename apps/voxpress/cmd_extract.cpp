@@ -11,6 +11,8 @@ struct ExtractCmd {
 };
 
 void run_extract(const ExtractCmd& c, const Global& g) {
+  check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.stats_json, OutputKind::json}});
+
   mesh_format_from_path(c.output);  // fail on a bad extension before any work
   Stopwatch clock;
   ProgressBar bar(!g.quiet);

@@ -11,6 +11,8 @@ struct GenerateCmd {
 };
 
 void run_generate(const GenerateCmd& c, const Global& g) {
+  check_paths({}, {{c.output, OutputKind::volume}, {c.stats_json, OutputKind::json}});
+
   Stopwatch clock;
   const ShapeKind kind = parse_shape(c.shape);
   GenerateOptions o;

@@ -19,6 +19,8 @@ std::string fmt(double v) {
 }
 
 void run_info(const InfoCmd& c, const Global& g) {
+  check_paths({c.input}, {{c.json, OutputKind::json}});
+
   const ScalarVolume v = load_volume(c.input, c.in, g);
   const Lattice& L = v.lattice;
   nlohmann::json j;

@@ -100,6 +100,8 @@ void write_features(const std::string& path, const Mesh& mesh) {
 }
 
 void run_press(const PressCmd& c, const Global& g) {
+  check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.features, OutputKind::features}, {c.stats_json, OutputKind::json}});
+
   mesh_format_from_path(c.output);  // a bad extension fails before any work
   SurfaceOptions so;
   so.method = parse_method(c.method);

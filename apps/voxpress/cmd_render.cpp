@@ -45,6 +45,8 @@ struct RenderCmd {
 };
 
 void run_render(const RenderCmd& c, const Global& g) {
+  check_paths(c.inputs, {{c.output, OutputKind::png}});
+
   if (!c.output.ends_with(".png")) throw UsageError("render writes a .png picture, not '" + c.output + "'");
   RenderOptions o;
   o.view = parse_view(c.view);

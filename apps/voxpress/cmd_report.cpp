@@ -159,6 +159,8 @@ std::string html_escape(const std::string& s) {
 }
 
 void run_report(const ReportCmd& c, const Global& g) {
+  check_paths({c.input, c.truth}, {{c.output, OutputKind::html}, {c.stats_json, OutputKind::json}});
+
   if (!c.output.ends_with(".html")) throw UsageError("report writes an .html file, not '" + c.output + "'");
   std::vector<std::string> methods;
   {

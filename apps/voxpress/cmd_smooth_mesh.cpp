@@ -16,6 +16,8 @@ struct SmoothMeshCmd {
 };
 
 void run_smooth_mesh(const SmoothMeshCmd& c, const Global& g) {
+  check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.stats_json, OutputKind::json}});
+
   mesh_format_from_path(c.output);  // a bad extension fails before any work
   const std::optional<FairOptions::Kind> kind = fair_kind(c.method);
   if (!kind && c.method != "constrained")

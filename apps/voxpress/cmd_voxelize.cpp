@@ -14,6 +14,8 @@ struct VoxelizeCmd {
 };
 
 void run_voxelize(const VoxelizeCmd& c, const Global& g) {
+  check_paths({c.model}, {{c.output, OutputKind::volume}, {c.stats_json, OutputKind::json}});
+
   Stopwatch clock;
   const Mesh model = read_mesh(c.model, {g.memory_limit()});
   VoxelizeOptions o;

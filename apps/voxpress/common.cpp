@@ -4,7 +4,9 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -251,6 +253,72 @@ nlohmann::json lattice_json(const Lattice& l) {
   j["direction_columns"] = d;
   j["space"] = space_name(l.space);
   return j;
+}
+
+namespace {
+std::string lower_ext(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  for (char& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  for (const char* two : {".nii.gz", ".seg.nrrd"})
+    if (name.ends_with(two)) return two;
+  const size_t dot = name.rfind('.');
+  return dot == std::string::npos ? "" : name.substr(dot);
+}
+
+// The same file: by identity when both exist, by their absolute, normal
+// paths otherwise.
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  return fs::weakly_canonical(fs::absolute(a), ec) == fs::weakly_canonical(fs::absolute(b), ec);
+}
+}  // namespace
+
+void check_paths(const std::vector<std::string>& inputs,
+                 const std::vector<std::pair<std::string, OutputKind>>& outputs) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> all;
+  for (const auto& p : inputs)
+    if (!p.empty()) all.push_back(p);
+  for (const auto& o : outputs)
+    if (!o.first.empty()) all.push_back(o.first);
+  for (size_t i = 0; i < all.size(); ++i)
+    for (size_t j = i + 1; j < all.size(); ++j)
+      if (same_file(all[i], all[j]))
+        throw UsageError(all[j] + ": names the same file as " + all[i] + " (each input and output needs its own)");
+  for (const auto& [path, kind] : outputs) {
+    if (path.empty()) continue;
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw UsageError(path + ": is a folder; give a file name for the output");
+    const std::string ext = lower_ext(path);
+    auto known = [&](std::initializer_list<const char*> exts) {
+      for (const char* e : exts)
+        if (ext == e) return true;
+      return false;
+    };
+    const char* expected = nullptr;
+    switch (kind) {
+      case OutputKind::mesh:
+        if (!known({".ply", ".obj", ".stl", ".off", ".glb", ".gltf"})) expected = ".ply .obj .stl .off .glb .gltf";
+        break;
+      case OutputKind::volume:
+        if (!known({".nrrd", ".seg.nrrd", ".nii", ".nii.gz", ".mha", ".tif", ".tiff"}))
+          expected = ".nrrd .nii .nii.gz .mha .tif";
+        break;
+      case OutputKind::json: if (!known({".json"})) expected = ".json"; break;
+      case OutputKind::png: if (!known({".png"})) expected = ".png"; break;
+      case OutputKind::svg: if (!known({".svg"})) expected = ".svg"; break;
+      case OutputKind::html: if (!known({".html", ".htm"})) expected = ".html"; break;
+      case OutputKind::features: if (!known({".ply", ".obj"})) expected = ".ply .obj"; break;
+    }
+    if (expected)
+      throw UsageError(path + ": unknown output format '" + ext + "' (use " + expected + ")");
+    fs::path dir = fs::path(path).parent_path();
+    if (dir.empty()) dir = ".";
+    if (!fs::is_directory(dir, ec)) throw UsageError(path + ": the output folder " + dir.string() + " does not exist");
+    if (::access(dir.c_str(), W_OK) != 0) throw UsageError(path + ": the output folder " + dir.string() + " is not writable");
+  }
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) {

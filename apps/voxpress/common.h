@@ -135,6 +135,15 @@ class Stopwatch {
   std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
+/// What an output path must name (its extension).
+enum class OutputKind { mesh, volume, json, png, svg, html, features };
+/// Before any work: each output's folder exists and is writable, the output
+/// is not a folder and its extension is one its kind writes; no two paths of
+/// the command (inputs and outputs; empty ones are skipped) name the same
+/// file. Throws UsageError naming the path.
+void check_paths(const std::vector<std::string>& inputs,
+                 const std::vector<std::pair<std::string, OutputKind>>& outputs);
+
 nlohmann::json lattice_json(const Lattice& l);
 /// Writes a JSON document atomically (pretty-printed).
 void write_json(const std::string& path, const nlohmann::json& j);

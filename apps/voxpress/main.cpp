@@ -33,7 +33,11 @@ int main(int argc, char** argv) {
   cli::register_report(app, g);
 
   try {
+    // Every output of the run appears together, once it has succeeded
+    // (check_paths refused bad output paths before any work).
+    OutputGroup outputs;
     app.parse(argc, argv);
+    outputs.commit();
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {

@@ -33,6 +33,7 @@ Mesh read_stl(const std::string& path, uint64_t max_bytes);
 void write_stl(const std::string& path, const Mesh& m);
 Mesh read_off(const std::string& path, uint64_t max_bytes);
 void write_off(const std::string& path, const Mesh& m);
+Mesh read_gltf(const std::string& path, uint64_t max_bytes, bool binary);
 void write_gltf(const std::string& path, const Mesh& m, bool binary);
 
 }  // namespace voxpress::detail

@@ -235,6 +235,11 @@ void remove_stale_temporaries(const fs::path& dir, const std::string& prefix) {
 
 }  // namespace
 
+namespace {
+// The open OutputGroup's pending (temporary, name) pairs; null when none is open.
+thread_local std::vector<std::pair<fs::path, fs::path>>* g_pending = nullptr;
+}  // namespace
+
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
   static std::atomic<unsigned> counter{0};
   const fs::path target(path);
@@ -251,6 +256,17 @@ void write_atomically(const std::string& path, const std::function<void(const st
   remove_stale_temporaries(dir, std::string(".").append(target.filename().string()).append(".tmp"));
   try {
     write(tmp.string());
+    if (g_pending) {
+      // A second write of one name in a group replaces the first.
+      for (auto& [t, final_name] : *g_pending)
+        if (final_name == target) {
+          fs::remove(t, ec);
+          t = tmp;
+          return;
+        }
+      g_pending->emplace_back(tmp, target);
+      return;
+    }
     fs::rename(tmp, target, ec);
     if (ec) throw InputError(path, "cannot write: " + ec.message());
   } catch (...) {
@@ -275,4 +291,35 @@ namespace voxpress {
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   detail::write_stream_atomically(path, write);
 }
+
+namespace fs = std::filesystem;
+
+OutputGroup::OutputGroup() {
+  if (detail::g_pending) throw std::logic_error("OutputGroup: groups do not nest");
+  detail::g_pending = new std::vector<std::pair<fs::path, fs::path>>();
+}
+
+OutputGroup::~OutputGroup() {
+  if (!detail::g_pending) return;
+  std::error_code ec;
+  for (const auto& [tmp, name] : *detail::g_pending) fs::remove(tmp, ec);
+  delete detail::g_pending;
+  detail::g_pending = nullptr;
+}
+
+void OutputGroup::commit_open() {
+  auto* pending = detail::g_pending;
+  if (!pending) return;
+  for (size_t i = 0; i < pending->size(); ++i) {
+    std::error_code ec;
+    fs::rename((*pending)[i].first, (*pending)[i].second, ec);
+    if (ec) {
+      pending->erase(pending->begin(), pending->begin() + std::ptrdiff_t(i));
+      throw InputError((*pending)[0].second.string(), "cannot write: " + ec.message());
+    }
+  }
+  pending->clear();
+}
+
+void OutputGroup::commit() { commit_open(); }
 }  // namespace voxpress

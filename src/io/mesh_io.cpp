@@ -39,8 +39,10 @@ Mesh read_mesh(const std::string& path, const MeshReadOptions& options) {
     case MeshFormat::obj: return detail::read_obj(path, cap);
     case MeshFormat::stl: return detail::read_stl(path, cap);
     case MeshFormat::off: return detail::read_off(path, cap);
-    default: throw InputError(path, "reading glTF meshes is not supported (use PLY, OBJ, STL or OFF)");
+    case MeshFormat::gltf: return detail::read_gltf(path, cap, false);
+    case MeshFormat::glb: return detail::read_gltf(path, cap, true);
   }
+  return {};
 }
 
 }  // namespace voxpress

@@ -18,9 +18,63 @@ namespace {
 const auto& fmt = format_double;
 }  // namespace
 
+namespace {
+// tinyobjloader reads a number it cannot parse as 0 (`v nan 0 0`, `v abc 0
+// 0`) and an index it cannot parse as a missing one. Before it runs, every
+// numeric field of the records it reads (v, vt, vn, f, l) must parse whole:
+// a float for v / vt / vn (finite), index[/index[/index]] for f and l.
+void check_obj_numbers(const std::string& path, uint64_t max_bytes) {
+  const auto bytes = read_whole_file(path, max_bytes, "reading the OBJ file");
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  size_t line_no = 0;
+  for (size_t pos = 0; pos < text.size();) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    const auto words = split_ws(line);
+    if (words.empty()) continue;
+    const std::string& key = words[0];
+    const bool vec = key == "v" || key == "vt" || key == "vn", elem = key == "f" || key == "l";
+    if (!vec && !elem) continue;
+    const std::string where = "line " + std::to_string(line_no) + " (" + key + ")";
+    if (words.size() < (key == "vt" ? 2u : key == "l" ? 3u : 4u)) throw InputError(path, where + ": too few values");
+    for (size_t w = 1; w < words.size(); ++w) {
+      const std::string& tok = words[w];
+      if (vec) {
+        double x = 0;
+        const char* first = tok.data() + (tok[0] == '+' ? 1 : 0);
+        const auto [ptr, ec] = std::from_chars(first, tok.data() + tok.size(), x);
+        if (ec != std::errc() || ptr != tok.data() + tok.size() || !std::isfinite(x))
+          throw InputError(path, where + ": '" + tok + "' is not a finite number");
+        continue;
+      }
+      // index, index/index, index//index or index/index/index; nonzero integers.
+      size_t start = 0;
+      for (int part = 0; part < 3 && start <= tok.size(); ++part) {
+        const size_t slash = std::min(tok.find('/', start), tok.size());
+        const std::string_view piece(tok.data() + start, slash - start);
+        if (!(piece.empty() && part > 0)) {
+          long long i = 0;
+          const auto [ptr, ec] = std::from_chars(piece.data(), piece.data() + piece.size(), i);
+          if (ec != std::errc() || ptr != piece.data() + piece.size() || i == 0)
+            throw InputError(path, where + ": '" + tok + "' is not a vertex index");
+        }
+        start = slash + 1;
+        if (slash == tok.size()) break;
+        if (part == 2) throw InputError(path, where + ": '" + tok + "' is not a vertex index");
+      }
+    }
+  }
+}
+}  // namespace
+
 Mesh read_obj(const std::string& path, uint64_t max_bytes) {
   const uint64_t fs = file_size(path);
   check_limit(path, fs * 4, max_bytes, "parsing the OBJ file");
+  check_obj_numbers(path, max_bytes);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
@@ -136,6 +190,96 @@ void write_obj(const std::string& path, const Mesh& m) {
     for (const auto& e : m.edges) buf += "l " + std::to_string(e[0] + 1) + " " + std::to_string(e[1] + 1) + "\n";
     out << buf;
   });
+}
+
+Mesh read_gltf(const std::string& path, uint64_t max_bytes, bool binary) {
+  const uint64_t fs = file_size(path);
+  check_limit(path, fs * 3, max_bytes, "parsing the glTF file");
+  tinygltf::TinyGLTF loader;
+  // Images are not needed to check or measure a mesh (and a missing one
+  // would fail the whole load).
+  loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                           void*) { return true; },
+                        nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                         : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  if (!ok) {
+    std::string e = trim(err);
+    if (const auto nl = e.find('\n'); nl != std::string::npos) e = e.substr(0, nl);
+    throw InputError(path, "cannot parse glTF" + (e.empty() ? "" : " (" + e + ")"));
+  }
+  for (const auto& node : model.nodes)
+    if (!node.matrix.empty() || !node.translation.empty() || !node.rotation.empty() || !node.scale.empty())
+      throw InputError(path, "glTF node transforms are not supported (positions are read as stored)");
+  // One accessor's elements as doubles, checked against its buffer.
+  auto read_accessor = [&](int index, int want_type, std::vector<double>& out) {
+    if (index < 0 || size_t(index) >= model.accessors.size()) throw InputError(path, "glTF accessor index out of range");
+    const tinygltf::Accessor& a = model.accessors[size_t(index)];
+    if (a.type != want_type) throw InputError(path, "glTF accessor of an unexpected type");
+    if (a.sparse.isSparse) throw InputError(path, "sparse glTF accessors are not supported");
+    if (a.bufferView < 0 || size_t(a.bufferView) >= model.bufferViews.size())
+      throw InputError(path, "glTF accessor without a buffer view");
+    const tinygltf::BufferView& bv = model.bufferViews[size_t(a.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= model.buffers.size()) throw InputError(path, "glTF buffer index out of range");
+    const auto& data = model.buffers[size_t(bv.buffer)].data;
+    const int comps = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+    const int csize = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+    if (comps <= 0 || csize <= 0) throw InputError(path, "glTF accessor of an unknown component type");
+    const uint64_t elem = uint64_t(comps) * uint64_t(csize);
+    const uint64_t stride = bv.byteStride ? bv.byteStride : elem;
+    const uint64_t start = uint64_t(bv.byteOffset) + uint64_t(a.byteOffset);
+    if (a.count > 0 && (stride < elem || start + (uint64_t(a.count) - 1) * stride + elem > data.size() ||
+                        uint64_t(a.byteOffset) + (uint64_t(a.count) - 1) * stride + elem > bv.byteLength))
+      throw InputError(path, "glTF accessor runs past its buffer (truncated?)");
+    check_limit(path, uint64_t(a.count) * uint64_t(comps) * 8, max_bytes, "reading a glTF accessor");
+    out.resize(size_t(a.count) * size_t(comps));
+    for (size_t i = 0; i < a.count; ++i)
+      for (int c = 0; c < comps; ++c) {
+        const unsigned char* p = data.data() + start + i * stride + uint64_t(c) * uint64_t(csize);
+        double v = 0;
+        switch (a.componentType) {
+          case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
+          case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
+          default: throw InputError(path, "glTF accessor of an unsupported component type");
+        }
+        out[i * size_t(comps) + size_t(c)] = v;
+      }
+  };
+  Mesh m;
+  std::vector<double> pos, idx;
+  for (const auto& mesh : model.meshes)
+    for (const auto& prim : mesh.primitives) {
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) continue;  // points and lines carry no faces
+      const auto it = prim.attributes.find("POSITION");
+      if (it == prim.attributes.end()) throw InputError(path, "glTF primitive without positions");
+      if (model.accessors[size_t(std::max(0, it->second))].componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+        throw InputError(path, "glTF positions must be float32");
+      read_accessor(it->second, TINYGLTF_TYPE_VEC3, pos);
+      const size_t base = m.positions.size(), nv = pos.size() / 3;
+      for (size_t v = 0; v < nv; ++v) m.positions.emplace_back(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]);
+      if (prim.indices >= 0) {
+        read_accessor(prim.indices, TINYGLTF_TYPE_SCALAR, idx);
+      } else {
+        idx.resize(nv);
+        for (size_t v = 0; v < nv; ++v) idx[v] = double(v);
+      }
+      if (idx.size() % 3) throw InputError(path, "glTF triangle indices are not a multiple of 3");
+      for (size_t i = 0; i < idx.size(); i += 3) {
+        Triangle t;
+        for (int c = 0; c < 3; ++c) {
+          if (idx[i + size_t(c)] >= double(nv)) throw InputError(path, "glTF face uses a missing vertex");
+          t[size_t(c)] = uint32_t(base + size_t(idx[i + size_t(c)]));
+        }
+        m.triangles.push_back(t);
+      }
+    }
+  if (m.triangles.empty()) throw InputError(path, "the glTF file holds no triangles");
+  m.validate(path);
+  return m;
 }
 
 void write_gltf(const std::string& path, const Mesh& m, bool binary) {

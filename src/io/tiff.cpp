@@ -10,6 +10,7 @@
 #include <tiffio.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstdarg>
 #include <cstring>
 #include <filesystem>
@@ -89,7 +90,56 @@ PageInfo page_info(const std::string& path, TIFF* t) {
 }
 
 // Decodes the current page into out (width * height samples of p.type).
-void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* out, uint64_t max_bytes) {
+// The current page's directory and every tag value stored outside it lie
+// inside the file (libtiff drops a value it cannot read, such as a cut
+// XResolution, without an error, and the spacing would default to 1).
+void check_directory_in_file(const std::string& path, TIFF* t, tdir_t page, uint64_t file_bytes) {
+  const bool big = TIFFIsBigTIFF(t), swapped = TIFFIsByteSwapped(t);
+  auto number = [&](uint64_t at, size_t width) {
+    if (at > file_bytes || width > file_bytes - at)
+      throw InputError(path, "truncated TIFF: page " + std::to_string(page) + "'s directory runs past the end of the file");
+    const auto b = read_range(path, at, width);
+    uint64_t v = 0;
+    for (size_t i = 0; i < width; ++i) {
+      const size_t k = swapped != (std::endian::native == std::endian::little) ? width - 1 - i : i;  // little-endian file
+      v = (v << 8) | uint64_t(std::to_integer<uint8_t>(b[k]));
+    }
+    return v;
+  };
+  const uint64_t dir = TIFFCurrentDirOffset(t);
+  const size_t count_width = big ? 8 : 2, entry = big ? 20 : 12, inline_bytes = big ? 8 : 4;
+  const uint64_t entries = number(dir, count_width);
+  number(dir + count_width + entries * entry, big ? 8 : 4);  // the link to the next page
+  for (uint64_t e = 0; e < entries; ++e) {
+    const uint64_t at = dir + count_width + e * entry;
+    const uint64_t type = number(at + 2, 2), n = number(at + 4, big ? 8 : 4);
+    static constexpr uint8_t kTypeBytes[19] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4, 0, 0, 8, 8, 8};
+    const uint64_t width = type < 19 ? kTypeBytes[type] : 0;
+    if (width == 0 || n == 0 || n > file_bytes / width || n * width <= inline_bytes) continue;
+    const uint64_t value_at = number(at + 4 + (big ? 8 : 4), big ? 8 : 4);
+    if (value_at > file_bytes || n * width > file_bytes - value_at)
+      throw InputError(path, "truncated TIFF: a value of page " + std::to_string(page) + " lies past the end of the file");
+  }
+}
+
+// Every strip or tile of the current page lies inside the file (libtiff
+// reads a cut strip short without an error).
+void check_chunks_in_file(const std::string& path, TIFF* t, tdir_t page, uint64_t file_bytes) {
+  check_directory_in_file(path, t, page, file_bytes);
+  const bool tiled = TIFFIsTiled(t);
+  uint64_t* offsets = nullptr;
+  uint64_t* counts = nullptr;
+  if (!TIFFGetField(t, tiled ? TIFFTAG_TILEOFFSETS : TIFFTAG_STRIPOFFSETS, &offsets) ||
+      !TIFFGetField(t, tiled ? TIFFTAG_TILEBYTECOUNTS : TIFFTAG_STRIPBYTECOUNTS, &counts) || !offsets || !counts)
+    throw InputError(path, "TIFF page " + std::to_string(page) + " has no data offsets");
+  const uint32_t n = tiled ? TIFFNumberOfTiles(t) : TIFFNumberOfStrips(t);
+  for (uint32_t i = 0; i < n; ++i)
+    if (offsets[i] > file_bytes || counts[i] > file_bytes - offsets[i])
+      throw InputError(path, "truncated TIFF: page " + std::to_string(page) + "'s data runs past the end of the file");
+}
+
+void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* out, uint64_t max_bytes, tdir_t page,
+               uint64_t file_bytes) {
   const size_t vs = scalar_size(p.type);
   const size_t row_bytes = p.bits == 1 ? (p.width + 7) / 8 : size_t(p.width) * vs;
   auto store_row = [&](const uint8_t* src, uint32_t y, uint32_t x0, uint32_t n) {
@@ -117,6 +167,7 @@ void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* o
     const tmsize_t tile_bytes = TIFFTileSize(t);
     if (tile_bytes <= 0) throw InputError(path, "invalid TIFF tile size");
     check_limit(path, uint64_t(tile_bytes), max_bytes, "a TIFF tile");
+    check_chunks_in_file(path, t, page, file_bytes);
     std::vector<uint8_t> tile(static_cast<size_t>(tile_bytes));
     for (uint32_t y0 = 0; y0 < p.height; y0 += th)
       for (uint32_t x0 = 0; x0 < p.width; x0 += tw) {
@@ -128,6 +179,7 @@ void read_page(const std::string& path, TIFF* t, const PageInfo& p, std::byte* o
       }
     return;
   }
+  check_chunks_in_file(path, t, page, file_bytes);
   std::vector<uint8_t> row(std::max<size_t>(size_t(TIFFScanlineSize(t)), row_bytes));
   for (uint32_t y = 0; y < p.height; ++y) {
     if (TIFFReadScanline(t, row.data(), y, 0) < 0)
@@ -206,6 +258,7 @@ ScalarVolume read_tiff(const std::string& path, uint64_t max_bytes) {
   const PageInfo first = page_info(path, t.get());
   const tdir_t pages = TIFFNumberOfDirectories(t.get());
   if (pages == 0) throw InputError(path, "TIFF without pages");
+  const uint64_t file_bytes = file_size(path);
   v.type = first.type;
   v.lattice.dims = {int64_t(first.width), int64_t(first.height), int64_t(pages)};
   const size_t vs = scalar_size(v.type);
@@ -218,8 +271,12 @@ ScalarVolume read_tiff(const std::string& path, uint64_t max_bytes) {
     if (!TIFFSetDirectory(t.get(), z)) throw InputError(path, "cannot read TIFF page " + std::to_string(z));
     const PageInfo p = page_info(path, t.get());
     if (!(p == first)) throw InputError(path, "TIFF page " + std::to_string(z) + " differs in size or type from page 0");
-    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes, max_bytes);
+    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes, max_bytes, z, file_bytes);
   }
+  // libtiff counts the pages it can reach: a cut file ends its chain early.
+  // The last page it reached must be the last one the file names.
+  if (!TIFFLastDirectory(t.get()))
+    throw InputError(path, "truncated TIFF: page " + std::to_string(pages) + " links to a page past the end of the file");
   return v;
 }
 
@@ -255,7 +312,7 @@ ScalarVolume read_tiff_folder(const std::string& dir, uint64_t max_bytes) {
     } else if (!(p == first)) {
       throw InputError(path, "slice differs in size or type from " + files[0]);
     }
-    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes, max_bytes);
+    read_page(path, t.get(), p, v.bytes.data() + z * page_bytes, max_bytes, 0, file_size(path));
   }
   return v;
 }

@@ -16,6 +16,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "core/clearance.h"
 #include "core/predicates.h"
 #include "core/sentinel.h"
 #include "crease_fit.h"
@@ -114,11 +115,15 @@ struct Sharpener {
   // the bucket and the reach below both use this rounded point).
   std::vector<Eigen::Vector3f> anchor;
   double anchor_reach = 0;   // cells: farthest any triangle's vertex has been from its anchor (max norm)
+  // Cells: the clearance every move keeps (samples, altitudes, triangle
+  // pairs) so that float32 output keeps the guarantee (core/clearance.h).
+  double delta = 0;
   SharpenStats st;
 
   Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
       : s(surface), seg(f), o(opts), n(surface.stick_count()) {
     Minv_t = s.lattice.index_to_physical_matrix().inverse().transpose();
+    delta = detail::float32_clearance(s.lattice, o.max_move + 1);
   }
 
   Vec3 physical_normal(const Vec3& index_normal) const { return (Minv_t * index_normal).normalized(); }
@@ -1307,17 +1312,31 @@ struct Sharpener {
       const Vec3& b = x[t[size_t((i + 2) % 3)]];
       const Vec3 nn = (a - q).cross(b - q);
       if (!(nn.squaredNorm() > 1e-20) || nn.dot((a - p).cross(b - p)) <= 0) return false;  // turned over
-      if (detail::triangle_degenerate(q, a, b)) return false;
+      if (detail::triangle_degenerate(q, a, b) || detail::triangle_altitude(q, a, b) < delta) return false;
       lo = lo.cwiseMin(a).cwiseMin(b);
       hi = hi.cwiseMax(a).cwiseMax(b);
-      // No lattice sample in the swept tetrahedron (p, q, a, b).
-      const Vec3 tl = p.cwiseMin(q).cwiseMin(a).cwiseMin(b), th = p.cwiseMax(q).cwiseMax(a).cwiseMax(b);
+      // No lattice sample in the swept tetrahedron (p, q, a, b), nor within
+      // the clearance of the moved triangle (q, a, b).
+      const Vec3 tl = p.cwiseMin(q).cwiseMin(a).cwiseMin(b).array() - delta,
+                 th = p.cwiseMax(q).cwiseMax(a).cwiseMax(b).array() + delta;
       for (double zz = std::ceil(tl.z()); zz <= th.z(); ++zz)
         for (double yy = std::ceil(tl.y()); yy <= th.y(); ++yy)
-          for (double xx = std::ceil(tl.x()); xx <= th.x(); ++xx)
-            if (in_closed_tet(p, q, a, b, Vec3(xx, yy, zz))) return false;
+          for (double xx = std::ceil(tl.x()); xx <= th.x(); ++xx) {
+            const Vec3 z(xx, yy, zz);
+            if (in_closed_tet(p, q, a, b, z) || detail::point_triangle_distance2(z, q, a, b) <= delta * delta)
+              return false;
+          }
     }
-    // The fan does not fold onto itself, and no refined triangle nearby meets it.
+    lo.array() -= delta;
+    hi.array() += delta;
+    // The fan does not fold onto itself, and no refined triangle nearby meets
+    // it or comes within the clearance (boxes farther apart are).
+    auto too_close = [&](const Vec3 (&ta)[3], const uint32_t (&ia)[3], const Vec3 (&tb)[3], const uint32_t (&ib)[3]) {
+      const Vec3 alo = ta[0].cwiseMin(ta[1]).cwiseMin(ta[2]), ahi = ta[0].cwiseMax(ta[1]).cwiseMax(ta[2]);
+      const Vec3 blo = tb[0].cwiseMin(tb[1]).cwiseMin(tb[2]), bhi = tb[0].cwiseMax(tb[1]).cwiseMax(tb[2]);
+      if ((alo.array() > bhi.array() + delta).any() || (blo.array() > ahi.array() + delta).any()) return false;
+      return detail::triangles_intersect(ta, ia, tb, ib) || detail::triangles_within(ta, ia, tb, ib, delta);
+    };
     for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k)
       for (uint32_t k2 = k + 1; k2 < fan_off[v + 1]; ++k2) {
         const Triangle& t = tris[fan[k]];
@@ -1325,7 +1344,7 @@ struct Sharpener {
         const Vec3 fb[3] = {at(t[0]), at(t[1]), at(t[2])};
         const Vec3 ub[3] = {at(u[0]), at(u[1]), at(u[2])};
         const uint32_t fi[3] = {t[0], t[1], t[2]}, ui[3] = {u[0], u[1], u[2]};
-        if (detail::triangles_intersect(fb, fi, ub, ui)) return false;
+        if (too_close(fb, fi, ub, ui)) return false;
       }
     // A triangle meeting the box [lo, hi] has its anchor within anchor_reach
     // of it (plus a hair for the rounding of the differences).
@@ -1348,7 +1367,7 @@ struct Sharpener {
               const Triangle& t = tris[fan[k]];
               const Vec3 fb[3] = {at(t[0]), at(t[1]), at(t[2])};
               const uint32_t fi[3] = {t[0], t[1], t[2]};
-              if (detail::triangles_intersect(fb, fi, gb, gi)) return false;
+              if (too_close(fb, fi, gb, gi)) return false;
             }
           }
         }

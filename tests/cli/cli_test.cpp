@@ -264,9 +264,63 @@ TEST(Cli, BadInputsFailCleanly) {
   EXPECT_EQ(run_cli("generate blob -o " + tmp.path("b.nrrd"), &out), 2);
   EXPECT_EQ(run_cli("generate sphere --res 3 -o " + tmp.path("b.nrrd"), &out), 2);
   EXPECT_EQ(run_cli("frobnicate", &out), 2);
-  EXPECT_EQ(run_cli("extract " + tmp.path("s.nrrd") + " -o " + tmp.path("out.xyz"), &out), 1);
+  EXPECT_EQ(run_cli("extract " + tmp.path("s.nrrd") + " -o " + tmp.path("out.xyz"), &out), 2);
   EXPECT_NE(out.find("out.xyz"), std::string::npos);
   EXPECT_FALSE(fs::exists(tmp.path("out.ply")));
+}
+
+// Every output path is checked before any work (its folder, its extension,
+// and that no two paths of the command name one file), and a run's outputs
+// appear together or not at all.
+TEST(Cli, OutputPathsAreCheckedFirstAndAppearTogether) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate sphere --res 24 -o " + tmp.path("s.nrrd"), &out), 0);
+  const std::string input = test::read_file(tmp.path("s.nrrd"));
+  fs::create_directories(tmp.dir() / "folder");
+  std::ofstream(tmp.path("cut.nrrd"), std::ios::binary) << input.substr(0, input.size() / 2);
+  struct Bad {
+    std::string args, names, problem;
+  };
+  const std::string s = tmp.path("s.nrrd");
+  const Bad cases[] = {
+      // the input destroyed before: `info X --json X`
+      {"info " + s + " --json " + s, "s.nrrd", "same file"},
+      {"press " + s + " -o " + tmp.path("a.ply") + " --stats-json " + tmp.path("a.ply"), "a.ply", "same file"},
+      {"press " + s + " -o " + tmp.path("a.ply") + " --features " + tmp.dir().string() + "/./a.ply", "a.ply",
+       "same file"},
+      {"check " + tmp.path("m.ply") + " --json " + tmp.path("m.ply"), "m.ply", "same file"},
+      {"press " + s + " -o " + tmp.path("a.ply") + " --features " + tmp.path("a.json"), "a.json",
+       "unknown output format"},
+      // the output folder is checked before the input is read (the cut input is not what fails)
+      {"press " + tmp.path("cut.nrrd") + " -o " + tmp.path("missing/dir/a.ply"), "missing/dir", "does not exist"},
+      {"press " + s + " -o " + tmp.path("a.ply") + " --stats-json " + tmp.path("missing/s.json"), "missing",
+       "does not exist"},
+      {"press " + tmp.path("cut.nrrd") + " -o " + tmp.path("folder"), "folder", "is a folder"},
+      {"extract " + tmp.path("cut.nrrd") + " -o " + tmp.path("a.jpg"), "a.jpg", "unknown output format"},
+      {"generate sphere -o " + tmp.path("g.nrrd") + " --stats-json " + tmp.path("g.nrrd"), "g.nrrd", "same file"},
+      {"generate sphere -o " + tmp.path("g.nrrd") + " --stats-json " + tmp.path("g.txt"), "g.txt", "unknown output"},
+  };
+  for (const Bad& b : cases) {
+    SCOPED_TRACE(b.args);
+    const auto before = tmp.files();
+    EXPECT_EQ(run_cli("-q " + b.args, &out), 2) << out;
+    EXPECT_EQ(count_lines(out), 1u) << out;
+    EXPECT_NE(out.find(b.names), std::string::npos) << out;
+    EXPECT_NE(out.find(b.problem), std::string::npos) << out;
+    EXPECT_EQ(tmp.files(), before) << "an output or temporary file was left behind";
+  }
+  EXPECT_EQ(test::read_file(s), input) << "the input is untouched";
+  // A good run's outputs all appear; a failed check still delivers its report.
+  ASSERT_EQ(run_cli("-q press " + s + " -o " + tmp.path("p.ply") + " --stats-json " + tmp.path("p.json"), &out), 0);
+  EXPECT_TRUE(fs::exists(tmp.path("p.ply")) && fs::exists(tmp.path("p.json")));
+  ASSERT_EQ(run_cli("-q generate sphere --res 30 -o " + tmp.path("other.nrrd"), &out), 0);
+  EXPECT_EQ(run_cli("-q check " + tmp.path("p.ply") + " --volume " + tmp.path("other.nrrd") + " --json " +
+                        tmp.path("c.json"),
+                    &out),
+            1)
+      << out;
+  EXPECT_TRUE(fs::exists(tmp.path("c.json"))) << "the failed check's report";
 }
 
 TEST(Cli, VoxelizeExtractEvalPipeline) {
@@ -392,7 +446,7 @@ TEST(Cli, PressSmoothsAndKeepsEverySampleOnItsSide) {
   EXPECT_EQ(run_cli("-q press " + tmp.path("nope.nrrd") + " -o " + tmp.path("x.ply"), &out), 1);
   EXPECT_EQ(count_lines(out), 1u) << out;
   EXPECT_NE(out.find("nope.nrrd"), std::string::npos) << out;
-  EXPECT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("x.xyz"), &out), 1);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("t.nrrd") + " -o " + tmp.path("x.xyz"), &out), 2);
   EXPECT_NE(out.find("x.xyz"), std::string::npos) << out;
   EXPECT_EQ(tmp.files(), before);
 }

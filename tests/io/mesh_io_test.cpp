@@ -3,6 +3,9 @@
 
 #include <fstream>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "test_util.h"
 
 namespace voxpress {
@@ -156,6 +159,88 @@ TEST(MeshIO, GlbAndGltfReadBackWithTinygltf) {
     EXPECT_NEAR(p0[0], m.positions[0].x(), 1e-3);
     EXPECT_NEAR(pos.minValues[2], bounding_box(m)[0].z(), 1e-3);
   }
+}
+
+// read_mesh reads back what voxpress writes as glTF, float32 positions as stored.
+TEST(MeshIO, GlbAndGltfReadBackThroughReadMesh) {
+  test::TempDir tmp;
+  const Mesh m = sample_mesh();
+  for (const std::string name : {"r.glb", "r.gltf"}) {
+    SCOPED_TRACE(name);
+    write_mesh(tmp.path(name), m);
+    const Mesh back = read_mesh(tmp.path(name));
+    ASSERT_EQ(back.positions.size(), m.positions.size());
+    ASSERT_EQ(back.triangles, m.triangles);
+    for (size_t v = 0; v < m.positions.size(); ++v)
+      ASSERT_EQ(back.positions[v], m.positions[v].cast<float>().cast<double>());
+    const std::string bytes = test::read_file(tmp.path(name));
+    test::write_file(tmp.path("cut_" + name), bytes.substr(0, bytes.size() / 2));
+    EXPECT_THROW(read_mesh(tmp.path("cut_" + name)), InputError);
+  }
+}
+
+// Every numeric field of an OBJ must parse: tinyobjloader alone reads
+// `nan` and `abc` as 0 (which then passed check).
+TEST(MeshIO, ObjNumbersThatDoNotParseAreErrors) {
+  test::TempDir tmp;
+  const std::string tail = "v 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n";
+  test::write_file(tmp.path("ok.obj"), "v 0 0 0\n" + tail);
+  EXPECT_EQ(read_mesh(tmp.path("ok.obj")).face_count(), 4u);
+  for (const std::string bad : {"v nan 0 0\n", "v abc 0 0\n", "v 0 0 inf\n", "v 0 0\n", "v 1e999 0 0\n",
+                                "v 0 0 0\nvt 0.5 x\n", "v 0 0 0\nvn 0 0 1q\n"}) {
+    SCOPED_TRACE(bad);
+    test::write_file(tmp.path("bad.obj"), bad + tail);
+    try {
+      read_mesh(tmp.path("bad.obj"));
+      ADD_FAILURE() << "read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.obj"), std::string::npos);
+      EXPECT_NE(std::string(e.what()).find("line"), std::string::npos);
+    }
+  }
+  for (const std::string bad : {"f 1 2 x\n", "f 1 2 0\n", "f 1/a 2 3\n", "f 1/2/3/4 2 3\n"}) {
+    SCOPED_TRACE(bad);
+    test::write_file(tmp.path("badf.obj"), "v 0 0 0\n" + tail + bad);
+    EXPECT_THROW(read_mesh(tmp.path("badf.obj")), InputError);
+  }
+}
+
+// A run's outputs appear together or not at all (OutputGroup): an OBJ's
+// texture and MTL never without their OBJ, a JSON report never without the
+// mesh it describes.
+TEST(MeshIO, OutputGroupWritesEverythingOrNothing) {
+  test::TempDir tmp;
+  Mesh m = sample_mesh();
+  m.uvs.assign(m.positions.size(), Vec2(0.5, 0.5));
+  m.texture.width = m.texture.height = 2;
+  m.texture.rgba.assign(16, 200);
+  {
+    OutputGroup group;
+    write_mesh(tmp.path("t.obj"), m);
+    write_file_atomically(tmp.path("t.json"), [](std::ostream& o) { o << "{}"; });
+    // Nothing visible before the commit, only temporaries.
+    for (const std::string& f : tmp.files()) EXPECT_EQ(f[0], '.') << f;
+  }  // not committed: the temporaries are removed
+  EXPECT_TRUE(tmp.files().empty());
+  {
+    OutputGroup group;
+    write_mesh(tmp.path("t.obj"), m);
+    write_file_atomically(tmp.path("t.json"), [](std::ostream& o) { o << "{}"; });
+    group.commit();
+  }
+  EXPECT_EQ(tmp.files(), (std::vector<std::string>{"t.json", "t.mtl", "t.obj", "t.png"}));
+  // A process that dies before its commit (as under SIGKILL) leaves no named output.
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    OutputGroup group;
+    write_mesh(tmp.path("k.obj"), m);
+    _exit(0);  // no destructor, no commit
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  for (const std::string& f : tmp.files()) EXPECT_FALSE(f.starts_with("k.")) << f;
+  EXPECT_THROW({ OutputGroup a; OutputGroup b; }, std::logic_error);
 }
 
 TEST(MeshIO, FailedWritesLeaveNoFile) {

@@ -310,6 +310,29 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
   expect_input_error([&] { read_volume(tmp.path("junk.nii")); }, "junk.nii", "NIfTI");
   test::write_file(tmp.path("junk.tif"), std::string(400, 'x'));
   expect_input_error([&] { read_volume(tmp.path("junk.tif")); }, "junk.tif", "TIFF");
+  // A multi-page TIFF cut anywhere (a page's data, its directory, a value
+  // stored past it such as XResolution, the link to the next page) is an
+  // error, never fewer slices or a default spacing (libtiff reads what it
+  // reaches without a word).
+  {
+    const ScalarVolume stack = random_volume(ScalarType::u8, {9, 7, 12}, 4);
+    write_volume(tmp.path("whole.tif"), stack);
+    const std::string bytes = test::read_file(tmp.path("whole.tif"));
+    ASSERT_EQ(read_volume(tmp.path("whole.tif")).lattice.dims[2], 12);
+    size_t refused = 0, tried = 0;
+    for (size_t cut = 8; cut < bytes.size(); cut += cut < bytes.size() - 64 ? 13 : 1) {
+      test::write_file(tmp.path("cut.tif"), bytes.substr(0, cut));
+      ++tried;
+      try {
+        read_volume(tmp.path("cut.tif"));
+        ADD_FAILURE() << "a TIFF cut at " << cut << " of " << bytes.size() << " bytes was read";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("cut.tif"), std::string::npos);
+        ++refused;
+      }
+    }
+    EXPECT_EQ(refused, tried);
+  }
   // No temporary or partial output is left by a failed write.
   EXPECT_THROW(write_volume(tmp.path("nowhere/x.nrrd"), v), InputError);
   EXPECT_THROW(write_volume(tmp.path("x.vtk"), v), UsageError);

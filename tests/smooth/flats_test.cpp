@@ -81,10 +81,7 @@ Matches match_all(const std::vector<Flat>& flats, const std::vector<PlanarFace>&
 // the wrong side; frozen vertices exactly on their planes.
 void expect_guarantees(const StickSurface& s, const FlatSegmentation& seg, const BinaryVolume& v) {
   for (double t : s.t) ASSERT_TRUE(t >= 0.01 && t <= 0.99);
-  const Mesh m = to_mesh(s);
-  const MeshCheck mc = check_mesh(m);
-  EXPECT_TRUE(mc.ok()) << (mc.problems.empty() ? "" : mc.problems[0]);
-  EXPECT_EQ(check_classification(m, v).violations, 0u);
+  test::expect_guarantees(to_mesh(s), v);
   ASSERT_EQ(seg.region.size(), s.stick_count());
   for (size_t i = 0; i < s.stick_count(); ++i) {
     if (seg.region[i] < 0) continue;

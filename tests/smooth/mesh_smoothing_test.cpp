@@ -254,6 +254,8 @@ TEST(ConstrainedSmoothing, CellEdgeAndDiamondKeepEverySampleOnItsSide) {
       const MeshCheck r = check_mesh(lm.mesh, {.self_intersections = false});
       ASSERT_TRUE(r.closed() && r.manifold() && r.oriented()) << constraint_name(k);
       ASSERT_EQ(check_classification(lm.mesh, c.volume).violations, 0u) << constraint_name(k);
+      ASSERT_EQ(check_classification(test::rounded_to_float32(lm.mesh), c.volume).violations, 0u)
+          << constraint_name(k) << " in float32";
     }
     ++cases;
   }

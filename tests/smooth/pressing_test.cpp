@@ -57,10 +57,7 @@ TEST(Pressing, PropertyCorpusKeepsEveryGuarantee) {
       const PressStats st = press(s, o);
       EXPECT_LE(st.iterations, o.iterations);
       for (double t : s.t) ASSERT_TRUE(t >= o.margin && t <= 1 - o.margin);
-      const Mesh m = to_mesh(s);
-      const MeshCheck r = check_mesh(m);
-      ASSERT_TRUE(r.ok()) << c.name << ": " << (r.problems.empty() ? "" : r.problems[0]);
-      ASSERT_EQ(check_classification(m, c.volume).violations, 0u) << c.name;
+      test::expect_guarantees(to_mesh(s), c.volume);
     }
 }
 
@@ -83,10 +80,7 @@ TEST(Pressing, QuadricFitKeepsEveryGuaranteeOnThePropertyCorpus) {
         ASSERT_EQ(s.t[i], before[i]) << "a junction vertex moved";
       }
     }
-    const Mesh m = to_mesh(s);
-    const MeshCheck r = check_mesh(m);
-    ASSERT_TRUE(r.ok()) << c.name << ": " << (r.problems.empty() ? "" : r.problems[0]);
-    ASSERT_EQ(check_classification(m, c.volume).violations, 0u) << c.name;
+    test::expect_guarantees(to_mesh(s), c.volume);
   }
   EXPECT_GT(moved, 0u);
   StickSurface s = extract_sticks(test::property_volumes().front().volume);

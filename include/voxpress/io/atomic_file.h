@@ -13,4 +13,26 @@ namespace voxpress {
 /// the folder does not exist or the disk is full.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// A run's outputs appear together or not at all. While a group is open on
+/// this thread, every atomic write of the library (meshes, volumes, images,
+/// JSON, an OBJ's MTL and PNG) stops at its complete temporary file;
+/// commit() renames them all over their names, in the order they were
+/// written (one rename each, so the window in which only some are there is
+/// a few system calls long). A group destroyed without commit() removes its
+/// temporaries, and a killed process leaves only temporaries, which the next
+/// write of the same name removes. Groups do not nest.
+class OutputGroup {
+ public:
+  OutputGroup();
+  ~OutputGroup();
+  OutputGroup(const OutputGroup&) = delete;
+  OutputGroup& operator=(const OutputGroup&) = delete;
+  /// Renames every pending temporary over its name; throws InputError naming
+  /// the first that fails (those renamed before it stay).
+  void commit();
+  /// commit() of the group open on this thread, if any (a command whose
+  /// verdict is a failure still delivers its report).
+  static void commit_open();
+};
+
 }  // namespace voxpress

@@ -10,7 +10,9 @@
 // Readers: .ply (ASCII and binary of either endianness, any extra properties
 // kept as attributes, polygons fanned into triangles), .obj (tinyobjloader,
 // double precision), .stl (binary — even when the header starts with
-// "solid" — or ASCII; identical vertices welded), .off (OFF/COFF/NOFF).
+// "solid" — or ASCII; identical vertices welded), .off (OFF/COFF/NOFF),
+// .glb / .gltf (triangle primitives' float32 positions as stored, no node
+// transforms). Every numeric text field must parse whole (no silent 0).
 #pragma once
 
 #include <cstdint>
@@ -35,7 +37,7 @@ struct MeshReadOptions {
   uint64_t max_bytes = 0;  ///< memory cap; 0 = default_memory_limit()
 };
 
-/// Reads a PLY, OBJ, STL or OFF mesh. Throws InputError for missing files,
+/// Reads a PLY, OBJ, STL, OFF or glTF / GLB mesh. Throws InputError for missing files,
 /// malformed or truncated data and out-of-range indices.
 Mesh read_mesh(const std::string& path, const MeshReadOptions& options = {});
 
