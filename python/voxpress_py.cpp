@@ -51,7 +51,16 @@ ScalarType scalar_type(const py::dtype& d) {
 }
 
 Vec3 vec3(const py::object& o, const char* what) {
-  const auto v = o.cast<std::vector<double>>();
+  // A string is a sequence too (of characters): refuse it by name.
+  std::vector<double> v;
+  if (py::isinstance<py::str>(o) || !py::isinstance<py::sequence>(o))
+    throw UsageError(std::string(what) + " must be a sequence of 3 numbers, not " +
+                     std::string(py::str(py::type::of(o).attr("__name__"))));
+  try {
+    v = o.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw UsageError(std::string(what) + " must be a sequence of 3 numbers");
+  }
   if (v.size() != 3) throw UsageError(std::string(what) + " must have 3 values");
   return {v[0], v[1], v[2]};
 }
@@ -158,13 +167,15 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
   }
 }
 
-PyMesh py_press(const py::array& mask, const py::object& spacing, const py::object& origin, const py::object& direction,
+PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py::object& origin, const py::object& direction,
              const std::string& method, const std::string& axes, const py::object& label, const py::object& threshold,
              const py::kwargs& kw) {
   SurfaceOptions o;
   o.method = parse_method(method);
   set_options(o, kw);
   const Selection sel = selection(label, threshold);
+  // ArrayLike: nested lists and anything numpy.asarray takes.
+  const py::array mask = py::module_::import("numpy").attr("asarray")(mask_like);
   ScalarVolume scalar = to_volume(mask, spacing, origin, direction, axes);
   SurfaceResult r;
   double seconds_binarize = 0;

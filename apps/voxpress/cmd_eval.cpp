@@ -152,7 +152,9 @@ void register_eval(CLI::App& app, Global& g) {
                                          "voxel units, classification");
   c->in.bind(*cmd);
   cmd->add_option("--json", c->json, "Also write the report as JSON");
-  cmd->add_option("--samples", c->samples, "Area samples per direction")->capture_default_str();
+  cmd->add_option("--samples", c->samples, "Area samples per direction")
+      ->check(CLI::Range(size_t(1), size_t(100000000)))
+      ->capture_default_str();
   cmd->add_option("--seed", c->seed, "Sampling seed")->capture_default_str();
   cmd->add_option("--sharp-match", c->sharp_match,
                   "Voxels: a sharp curve point this close to the other set counts as found (recall, precision)")

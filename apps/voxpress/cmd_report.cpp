@@ -289,7 +289,9 @@ void register_report(CLI::App& app, Global& g) {
       ->capture_default_str();
   cmd->add_option("--truth", c->truth, "sphere|torus|box|cylinder|cad-part or a mesh file (default: the volume's own "
                                        "when it was generated or voxelized by voxpress)");
-  cmd->add_option("--samples", c->samples, "Area samples for the error figures")->capture_default_str();
+  cmd->add_option("--samples", c->samples, "Area samples for the error figures")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
   cmd->add_option("--title", c->title, "Page title");
   cmd->add_option("--stats-json", c->stats_json, "Also write the stats shown in the table as JSON");
   c->in.bind(*cmd);

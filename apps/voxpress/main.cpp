@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("voxpress ") + kVersion);
   app.require_subcommand(1);
   cli::Global g;
-  app.add_option("--threads", g.threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", g.threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 4096));
   app.add_flag("-q,--quiet", g.quiet, "No progress bar");
   app.add_option("--max-memory", g.max_memory, "Refuse inputs needing more memory than this (e.g. 8G; default: "
                                                "3/4 of RAM or $VOXPRESS_MAX_MEMORY)");

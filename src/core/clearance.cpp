@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include <Eigen/SVD>
+#include <Eigen/LU>
 
 namespace voxpress::detail {
 
@@ -21,8 +21,8 @@ double float32_clearance(const Lattice& lattice, double reach) {
       ijk[a] = (corner >> a) & 1 ? double(lattice.dims[size_t(a)] - 1) + reach : -reach;
     largest = std::max(largest, (lattice.origin + M * ijk).cwiseAbs().maxCoeff());
   }
-  const double sigma_min = Eigen::JacobiSVD<Mat3>(M).singularValues().minCoeff();
-  const double rounding = std::sqrt(3.0) * kHalfUlp * largest / sigma_min;  // index cells, worst vector
+  // ||M^-1||_2 <= ||M^-1||_F: physical -> index lengths, bounded above.
+  const double rounding = std::sqrt(3.0) * kHalfUlp * largest * M.inverse().norm();  // index cells, worst vector
   return std::max(4 * rounding, 1e-12);
 }
 

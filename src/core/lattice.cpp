@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <sstream>
 
 #include "voxpress/core/error.h"
 
@@ -29,9 +30,12 @@ void Lattice::validate() const {
   for (int a = 0; a < 3; ++a) {
     if (dims[a] < 1)
       throw UsageError("invalid dimension along axis " + std::to_string(a) + ": " + std::to_string(dims[a]));
-    if (!std::isfinite(spacing[a]) || spacing[a] <= 0)
-      throw UsageError("lattice spacing along axis " + std::to_string(a) + " must be finite and > 0");
-    if (!std::isfinite(origin[a])) throw UsageError("lattice origin is not finite");
+    // Physical units from picometres to megametres in millimetres: beyond,
+    // areas and volumes overflow or lose all precision.
+    if (!(spacing[a] >= 1e-12 && spacing[a] <= 1e12))
+      throw UsageError("lattice spacing along axis " + std::to_string(a) + " must be in [1e-12, 1e12], not " +
+                       (std::ostringstream() << spacing[a]).str());
+    if (!(std::abs(origin[a]) <= 1e15)) throw UsageError("lattice origin must be finite and within 1e15");
   }
   if (!direction.allFinite() || std::abs(index_to_physical_matrix().determinant()) < 1e-300)
     throw UsageError("lattice direction matrix is singular or not finite");

@@ -150,6 +150,7 @@ BinaryVolume binarize(const ScalarVolume& v, const Selection& sel) {
   switch (sel.kind) {
     case K::label: {
       const double label = sel.value;
+      if (!std::isfinite(label)) throw UsageError("the label must be a finite number, not " + format_value(label));
       BinaryVolume b = select_any_component(v, [label](double x) { return x == label; });
       if (b.count_inside() == 0)
         throw InputError(v.source, "no sample has label " + format_value(label) + " (see `voxpress info`)");
@@ -158,6 +159,7 @@ BinaryVolume binarize(const ScalarVolume& v, const Selection& sel) {
     case K::nonzero: return select_any_component(v, [](double x) { return x != 0; });
     case K::threshold: {
       const double t = sel.value;
+      if (!std::isfinite(t)) throw UsageError("the threshold must be a finite number, not " + format_value(t));
       return select_any_component(v, [t](double x) { return x >= t; });
     }
     case K::segment: {

@@ -4,7 +4,9 @@
 
 #include <chrono>
 
+#include "core/clearance.h"
 #include "core/timing.h"
+#include "io/io_util.h"
 
 namespace voxpress {
 
@@ -63,11 +65,92 @@ bool keeps_classification(Method m) {
   return m == Method::pressing || m == Method::diamond || m == Method::cell_edge;
 }
 
-SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
+namespace {
+// value in [lo, hi] (NaN never is); `name` as the CLI and Python spell it.
+void in_range(double value, double lo, double hi, const char* name) {
+  if (!(value >= lo && value <= hi))
+    throw UsageError(std::string(name) + " must be in [" + detail::format_double(lo) + ", " +
+                     detail::format_double(hi) + "], not " + detail::format_double(value));
+}
+// Iteration caps and ring counts beyond these only burn time (a ring count
+// of 12 already spans a whole small part).
+constexpr double kMaxIterations = 1e6, kMaxRings = 12;
+}  // namespace
+
+void validate(const SurfaceOptions& o) {
   const MethodOverrides& ov = o.overrides;
   if ((ov.lambda || ov.mu) && o.method != Method::taubin && o.method != Method::laplacian)
     throw UsageError("lambda and mu apply to taubin and laplacian only");
+  if (ov.iterations) in_range(*ov.iterations, 0, kMaxIterations, "iterations");
+  if (ov.tolerance) in_range(*ov.tolerance, 0, 1, "tolerance");
+  if (ov.lambda) in_range(*ov.lambda, -10, 10, "lambda");
+  if (ov.mu) in_range(*ov.mu, -10, 10, "mu");
+  const PressOptions& p = o.press;
+  in_range(p.iterations, 0, kMaxIterations, "iterations");
+  in_range(p.tolerance, 0, 1, "tolerance");
+  in_range(p.step, 1e-6, 2, "step");
+  in_range(p.arc_length, 1e-3, 16, "arc_length");
+  in_range(p.margin, 1e-4, 0.49, "margin");
+  in_range(p.levels, 0, 16, "levels");
+  in_range(p.momentum, 0, 0.99, "momentum");
+  in_range(p.circle_correction, 0, 90, "circle_correction");
+  in_range(o.fit.rings, 0, kMaxRings, "fit_rings");
+  in_range(o.fit.residual, 0, 10, "fit_residual");
+  in_range(o.fit.stab_eps, 0, 1, "fit_stab_eps");
+  const FlatOptions& f = o.flat;
+  in_range(f.min_area, 0, 1e12, "min_flat_area");
+  in_range(f.junction_angle, 0, 180, "junction_angle");
+  in_range(f.tangent_residual, 0, 10, "tangent_residual");
+  in_range(f.junction_ring_off_plane, 0, 10, "junction_ring_off_plane");
+  in_range(f.cone, 0, 90, "cone");
+  in_range(f.tolerance, 1e-6, 10, "flat_tolerance");
+  in_range(f.max_bend, 0, 180, "flat_bend");
+  in_range(f.max_spread, 0, 100, "max_spread");
+  in_range(f.min_width, 0, 1e6, "flat_width");
+  in_range(f.rim_rings, 0, kMaxRings, "rim_rings");
+  in_range(f.rim_tangent_angle, 0, 90, "rim_tangent_angle");
+  in_range(f.merge_angle, 0, 90, "merge_angle");
+  in_range(f.curved_gain, 0, 100, "curved_gain");
+  in_range(f.margin, 1e-4, 0.49, "flat margin");
+  in_range(f.estimate_iterations, 0, kMaxIterations, "estimate_iterations");
+  in_range(f.passes, 1, 8, "flat_passes");
+  in_range(f.crease_rings, 0, kMaxRings, "crease_rings");
+  in_range(f.crease_fit_rings, 0, kMaxRings, "crease_fit_rings");
+  in_range(f.crease_residual, 0, 10, "crease_residual");
+  in_range(f.crease_rounds, 0, 8, "crease_rounds");
+  const SharpenOptions& sh = o.sharp;
+  in_range(sh.sharp_angle, 0, 180, "sharp_angle");
+  in_range(sh.min_angle, 0, 180, "min_angle");
+  in_range(sh.max_move, 1e-3, 16, "max_move");
+  in_range(sh.chain_iterations, 0, 100000, "chain_iterations");
+  in_range(sh.min_curved, 0, 1e9, "min_curved");
+  in_range(sh.strip_rings, 0, kMaxRings, "strip_rings");
+  in_range(sh.curved_fit_rings, 0, kMaxRings, "curved_fit_rings");
+  in_range(sh.curved_fit_residual, 0, 10, "curved_fit_residual");
+  in_range(sh.snap_rings, 0, 2 * kMaxRings, "snap_rings");
+  in_range(sh.snap_tolerance, 0, 10, "snap_tolerance");
+  in_range(sh.snap_share, 0, 1, "snap_share");
+  in_range(sh.wall_thickness, 0, 64, "wall_thickness");
+  in_range(sh.final_crease_rings, 0, 8, "final_crease_rings");
+  in_range(sh.final_crease_fit_rings, 0, kMaxRings, "final_crease_fit_rings");
+  in_range(sh.final_crease_residual, 0, 10, "final_crease_residual");
+  in_range(sh.final_crease_max_move, 0, 10, "final_crease_max_move");
+  in_range(sh.band_reach, 0, kMaxRings, "band_reach");
+  in_range(sh.retry_right_angle, -1, 90, "retry_right_angle");
+  in_range(sh.margin, 1e-4, 0.49, "sharpen margin");
+}
+
+SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
+  const MethodOverrides& ov = o.overrides;
+  validate(o);
   require_mixed(volume);
+  // The output keeps the guarantee in float32 only if its rounding (delta / 4)
+  // stays well inside the clearance the pressing margin gives every sample
+  // (margin / sqrt(3)): a lattice far from the origin for its spacing cannot.
+  if (const double delta = detail::float32_clearance(volume.lattice); delta > o.press.margin)
+    throw InputError(volume.source, "its coordinates are too large for its spacing to be stored in float32 with "
+                                    "every sample on its side (rounding " + detail::format_double(delta / 4) +
+                                    " cells; move the origin closer to the volume)");
   SurfaceResult r;
   auto t0 = std::chrono::steady_clock::now();
   ExtractOptions eo = o.extract;

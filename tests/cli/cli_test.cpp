@@ -264,6 +264,22 @@ TEST(Cli, BadInputsFailCleanly) {
   EXPECT_EQ(run_cli("generate blob -o " + tmp.path("b.nrrd"), &out), 2);
   EXPECT_EQ(run_cli("generate sphere --res 3 -o " + tmp.path("b.nrrd"), &out), 2);
   EXPECT_EQ(run_cli("frobnicate", &out), 2);
+  // Absurd values are usage errors (exit 2, one line), never internal errors.
+  std::string cube(8 * 8 * 8, '\0');
+  cube[4 + 8 * (4 + 8 * 4)] = 1;
+  test::write_file(tmp.path("v.raw"), cube);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("v.raw") + " --raw-dims 8,8,8 -o " + tmp.path("o.ply"), &out), 0) << out;
+  for (const std::string& args :
+       {"press " + tmp.path("v.raw") + " -o " + tmp.path("o.ply") + " --raw-spacing 1e150,1,1 --raw-dims 8,8,8",
+        "report " + tmp.path("s.nrrd") + " -o " + tmp.path("o.html") + " --samples -5",
+        "eval " + tmp.path("s.nrrd") + " --samples 0", "--threads -1 info " + tmp.path("s.nrrd"),
+        "extract " + tmp.path("s.nrrd") + " -o " + tmp.path("o.ply") + " --threshold nan",
+        "press " + tmp.path("s.nrrd") + " -o " + tmp.path("o.ply") + " --sharp-angle 400"}) {
+    SCOPED_TRACE(args);
+    EXPECT_EQ(run_cli("-q " + args, &out), 2) << out;
+    EXPECT_EQ(count_lines(out), 1u) << out;
+    EXPECT_LT(out.size(), 200u) << out;
+  }
   EXPECT_EQ(run_cli("extract " + tmp.path("s.nrrd") + " -o " + tmp.path("out.xyz"), &out), 2);
   EXPECT_NE(out.find("out.xyz"), std::string::npos);
   EXPECT_FALSE(fs::exists(tmp.path("out.ply")));

@@ -110,6 +110,36 @@ def test_bad_arguments_raise_clear_exceptions():
     assert issubclass(voxpress.InputError, voxpress.Error)
 
 
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(iterations=-1), "iterations"),
+    (dict(tolerance=float("nan")), "tolerance"),
+    (dict(junction_angle=-5), "junction_angle"),
+    (dict(sharp_angle=400), "sharp_angle"),
+    (dict(spacing="1,1,1"), "sequence of 3 numbers"),
+    (dict(spacing=(1e150, 1, 1)), "spacing"),
+    (dict(origin=(float("inf"), 0, 0)), "origin"),
+])
+def test_out_of_range_options_are_the_libraries_usage_errors(kwargs, message):
+    with pytest.raises(voxpress.UsageError, match=message):
+        voxpress.press(ball(12, 4.5), **kwargs)
+
+
+def test_a_nested_list_is_an_array_like_mask():
+    m = ball(12, 4.5)
+    assert voxpress.press(m.astype(np.uint8).tolist()).vertices.shape == voxpress.press(m).vertices.shape
+
+
+def test_truncated_tiff_is_an_error_naming_the_file(tmp_path):
+    path = tmp_path / "stack.tif"
+    cli("generate", "sphere", "--res", 24, "-o", path)
+    data = path.read_bytes()
+    for cut in (500, len(data) // 2, len(data) - 10):
+        cut_path = tmp_path / f"cut{cut}.tif"
+        cut_path.write_bytes(data[:cut])
+        with pytest.raises(voxpress.InputError, match=f"cut{cut}.tif"):
+            voxpress.read_volume(str(cut_path))
+
+
 def test_wall_thickness_reaches_the_sharpening():
     # A tilted plate 3 cells thick: its rim lies between two opposite flats.
     i, j, k = np.indices((56, 56, 56)).astype(float) - 27.6

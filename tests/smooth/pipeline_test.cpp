@@ -1,6 +1,9 @@
 // smooth_surface: every method from one call, each with what it promises.
 #include <tbb/global_control.h>
 
+#include <cmath>
+#include <functional>
+
 #include "test_util.h"
 
 namespace voxpress {
@@ -65,6 +68,26 @@ TEST(Pipeline, RefusesBadOptionsAndEmptyVolumes) {
   EXPECT_THROW(smooth_surface(ball, o), UsageError);
   EXPECT_THROW(parse_method("smooth"), UsageError);
   EXPECT_THROW(smooth_surface(test::make_volume(4, 4, 4)), InputError);
+  // Out-of-range options are the library's one usage error (the CLI and
+  // Python share it).
+  for (auto bad : std::vector<std::function<void(SurfaceOptions&)>>{
+           [](SurfaceOptions& s) { s.press.iterations = -1; },
+           [](SurfaceOptions& s) { s.press.tolerance = std::nan(""); },
+           [](SurfaceOptions& s) { s.flat.junction_angle = -5; },
+           [](SurfaceOptions& s) { s.sharp.sharp_angle = 400; },
+           [](SurfaceOptions& s) { s.press.margin = 0; },
+           [](SurfaceOptions& s) { s.overrides.iterations = -3; }}) {
+    SurfaceOptions s;
+    bad(s);
+    EXPECT_THROW(validate(s), UsageError);
+    EXPECT_THROW(smooth_surface(ball, s), UsageError);
+  }
+  EXPECT_NO_THROW(validate(SurfaceOptions{}));
+  // A lattice whose float32 rounding would reach the pressing clearance.
+  BinaryVolume far = ball;
+  far.lattice.origin = Vec3(1e5, 0, 0);
+  far.lattice.spacing = Vec3(0.5, 0.5, 0.5);
+  EXPECT_THROW(smooth_surface(far), InputError);
 }
 
 // Deterministic (issue 11): the same bytes for 1 and 4 threads on a spread

@@ -82,6 +82,11 @@ struct SurfaceResult {
   double seconds_extract = 0, seconds_smooth = 0;
 };
 
+/// Throws UsageError naming the first option out of its range (NaN,
+/// negative or absurd counts, angles, tolerances, margins): the one check
+/// the CLI and the Python module share. smooth_surface calls it.
+void validate(const SurfaceOptions& options);
+
 /// The volume's smooth surface by `options.method`. Throws InputError for an
 /// empty or full volume, UsageError for invalid options, LimitError when
 /// options.extract.max_bytes would be exceeded.

@@ -42,7 +42,10 @@
 //     move is cut back (bisection) until no lattice sample lies in any swept
 //     tetrahedron, no incident triangle turns over and none meets another
 //     triangle nearby. So no sample ever changes side, and the mesh stays
-//     closed, 2-manifold and free of self-intersections.
+//     closed, 2-manifold and free of self-intersections. The move also keeps
+//     a clearance of 4x the worst float32 rounding (to every sample, between
+//     triangles, on every altitude), so the guarantee survives STL and glTF
+//     output (src/core/clearance.h).
 //
 // Output: the refined mesh (physical units) with a face attribute "region"
 // (flat id, or -1: curved, including the faces straddling a smooth border),
