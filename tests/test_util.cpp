@@ -188,7 +188,15 @@ Mesh rounded_to_float32(Mesh m) {
 
 void expect_guarantees(const Mesh& m, const BinaryVolume& v) {
   const Mesh f = rounded_to_float32(m);
-  for (const Mesh* mesh : {&m, &f}) {
+#if defined(__SANITIZE_ADDRESS__)
+  // Under the sanitizers (memory safety, CI's second part) the float32 pass
+  // would run the same checking code again on other numbers; the Release
+  // suite runs it.
+  const std::vector<const Mesh*> meshes{&m};
+#else
+  const std::vector<const Mesh*> meshes{&m, &f};
+#endif
+  for (const Mesh* mesh : meshes) {
     SCOPED_TRACE(mesh == &m ? "double" : "float32");
     const MeshCheck mc = check_mesh(*mesh);
     EXPECT_TRUE(mc.ok()) << (mc.problems.empty() ? "" : mc.problems[0]);

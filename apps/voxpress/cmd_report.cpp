@@ -160,6 +160,10 @@ std::string html_escape(const std::string& s) {
 
 void run_report(const ReportCmd& c, const Global& g) {
   check_paths({c.input, c.truth}, {{c.output, OutputKind::html}, {c.stats_json, OutputKind::json}});
+  if (!kReportScript || !kReportTemplate)
+    throw UsageError("this voxpress was built without the report viewer (Node.js and web/node_modules were missing "
+                     "when it was configured): run scripts/setup.sh, or install nodejs and npm, run `npm ci` in web/ "
+                     "and rebuild");
 
   if (!c.output.ends_with(".html")) throw UsageError("report writes an .html file, not '" + c.output + "'");
   std::vector<std::string> methods;

@@ -108,7 +108,13 @@ ScalarVolume load_volume(const std::string& path, const InputOptions& in, const 
 
 BinaryVolume load_binary(const std::string& path, const InputOptions& in, const Global& g) {
   const Selection sel = in.selection();  // usage errors before any I/O
-  BinaryVolume b = binarize(load_volume(path, in, g), sel);
+  ScalarVolume scalar = load_volume(path, in, g);
+  // The file's samples and their binary mask live together while binarising.
+  const uint64_t cap = g.memory_limit(), both = scalar.bytes.size() + scalar.lattice.size();
+  if (cap && both > cap)
+    throw LimitError(path, "reading and binarising it needs about " + std::to_string(both >> 20) +
+                               " MiB, above the memory limit of " + std::to_string(cap >> 20) + " MiB");
+  BinaryVolume b = binarize(std::move(scalar), sel);
   require_mixed(b);
   return b;
 }

@@ -9,6 +9,7 @@ Methods: "pressing" (default), "cesn", "diamond", "cell-edge", "cell-size",
 LimitError (all voxpress.Error) with the command line's messages.
 See voxpress/__init__.pyi for the signatures.
 """
+from . import _voxpress
 from ._voxpress import (  # noqa: F401
     Error,
     InputError,
@@ -19,10 +20,43 @@ from ._voxpress import (  # noqa: F401
     __version__,
     check,
     evaluate,
-    press,
     read_mesh,
     read_volume,
 )
+
+
+def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, method="pressing",
+          axes="xyz", label=None, threshold=None, iterations=None, tolerance=None, flats=None, sharpen=None,
+          min_flat_area=None, junction_angle=None, sharp_angle=None, wall_thickness=None, color_regions=None,
+          fit_rings=None, lambda_=None, mu=None):
+    """The smooth surface of a 3-D mask, as `voxpress press` computes it; returns a Mesh.
+
+    mask: bool, integer-label or float array (anything numpy.asarray takes);
+    C or Fortran order. axes="xyz" indexes it mask[i, j, k] (nibabel); "zyx"
+    mask[k, j, i] (SimpleITK.GetArrayFromImage). spacing, origin and
+    direction (3 x 3, column a = physical direction of index axis a) always
+    refer to the i, j, k axes. Inside samples: a mask with one non-zero value
+    needs nothing; label maps need label=N (or "all-nonzero"), grey images
+    threshold=T (value >= T).
+
+    method: "pressing" (default; every sample kept on its side), "cesn",
+    "diamond", "cell-edge", "cell-size", "taubin", "laplacian".
+    Options left at None keep the method's default:
+      iterations, tolerance  the smoothing's cap (pressing: 100) and stop (1e-4)
+      flats (True), sharpen (True)  plane voting and sharp-edge recovery (pressing)
+      min_flat_area (100 cells), junction_angle (30 deg), sharp_angle (30 deg),
+      wall_thickness (24 cells), color_regions (False), fit_rings (5)
+      lambda_, mu  Taubin / Laplacian steps
+    Out-of-range values raise UsageError with the command line's message; the
+    GIL is released while it works.
+    """
+    options = dict(iterations=iterations, tolerance=tolerance, flats=flats, sharpen=sharpen,
+                   min_flat_area=min_flat_area, junction_angle=junction_angle, sharp_angle=sharp_angle,
+                   wall_thickness=wall_thickness, color_regions=color_regions, fit_rings=fit_rings,
+                   lambda_=lambda_, mu=mu)
+    return _voxpress.press(mask, spacing=spacing, origin=origin, direction=direction, method=method, axes=axes,
+                           label=label, threshold=threshold,
+                           **{k: v for k, v in options.items() if v is not None})
 
 __all__ = ["Error", "InputError", "LimitError", "UsageError", "Lattice", "Mesh", "press", "read_volume",
            "read_mesh", "check", "evaluate", "__version__"]

@@ -64,7 +64,7 @@ struct BitEqual {
 };
 }  // namespace
 
-size_t weld_identical_vertices(Mesh& mesh) {
+std::vector<uint32_t> identical_positions(const Mesh& mesh, std::vector<uint32_t>* kept_out) {
   std::unordered_map<Vec3, uint32_t, BitHash, BitEqual> first;
   first.reserve(mesh.positions.size());
   std::vector<uint32_t> remap(mesh.positions.size());
@@ -79,6 +79,13 @@ size_t weld_identical_vertices(Mesh& mesh) {
     if (fresh) kept.push_back(uint32_t(v));
     remap[v] = it->second;
   }
+  if (kept_out) *kept_out = std::move(kept);
+  return remap;
+}
+
+size_t weld_identical_vertices(Mesh& mesh) {
+  std::vector<uint32_t> kept;
+  const std::vector<uint32_t> remap = identical_positions(mesh, &kept);
   const size_t removed = mesh.positions.size() - kept.size();
   if (removed == 0) return 0;
   auto compact = [&](auto& vec) {
@@ -91,6 +98,8 @@ size_t weld_identical_vertices(Mesh& mesh) {
   compact(mesh.positions);
   compact(mesh.normals);
   compact(mesh.colors);
+  compact(mesh.uvs);
+  for (auto& e : mesh.edges) e = {remap[e[0]], remap[e[1]]};
   for (auto& a : mesh.vertex_attributes) compact(a.values);
   std::vector<Triangle> tris;
   tris.reserve(mesh.triangles.size());

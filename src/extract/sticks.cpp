@@ -183,11 +183,17 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
     throw LimitError(volume.source, std::to_string(total) + " sticks exceed the 2^32 - 1 vertex limit of one mesh");
   // Triangles are about twice the vertices (each vertex has ~6 incident
   // triangles, each triangle 3 vertices); 17 bytes per stick, 12 per triangle.
-  const uint64_t estimate = total * (17 + 2 * 12);
-  if (options.max_bytes && estimate > options.max_bytes)
-    throw LimitError(volume.source, "the surface would need about " + std::to_string(estimate >> 20) +
-                                        " MiB, above the memory limit of " + std::to_string(options.max_bytes >> 20) +
-                                        " MiB");
+  const uint64_t surface = total * (17 + 2 * 12), later = total * options.later_bytes_per_stick;
+  const uint64_t estimate = volume.inside.size() + surface + later;
+  if (options.max_bytes && estimate > options.max_bytes) {
+    const bool small = options.max_bytes < (16u << 20);  // KiB below 16 MiB, so that no figure reads 0
+    auto size = [&](uint64_t b) { return std::to_string(small ? b >> 10 : b >> 20); };
+    const std::string unit = small ? " KiB" : " MiB";
+    throw LimitError(volume.source, "this needs about " + size(estimate) + unit + " (volume " +
+                                        size(volume.inside.size()) + ", surface " + size(surface) +
+                                        ", its smoothing " + size(later) + " for " + std::to_string(total) +
+                                        " sticks), above the memory limit of " + size(options.max_bytes) + unit);
+  }
   out.lower.resize(total);
   out.code.resize(total);
   out.t.assign(total, 0.5);

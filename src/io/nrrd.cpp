@@ -165,6 +165,8 @@ void parse_text(const std::string& path, const std::string& text, ScalarVolume& 
   if (k < n)
     throw InputError(path, "truncated: the text payload holds " + std::to_string(k) + " values but the header declares " +
                                std::to_string(n));
+  if (in >> tok)
+    throw InputError(path, "the text payload holds more than the " + std::to_string(n) + " values the header declares");
 }
 
 // NRRD accepts voxpress's integer type names as they are.
@@ -306,6 +308,10 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes) {
       files.push_back((base / *df).string());
     }
     if (files.empty()) throw InputError(path, "'data file: LIST' names no file");
+    // Named from the header the user gave, with the file it is missing.
+    std::error_code ec;
+    for (const auto& f : files)
+      if (!fs::exists(f, ec)) throw InputError(path, "its data file " + f + " does not exist");
   } else if (h.detached_header) {
     throw InputError(path, "the NRRD header has no blank line and no 'data file' field");
   }

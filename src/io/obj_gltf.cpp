@@ -138,10 +138,20 @@ void write_obj(const std::string& path, const Mesh& m) {
           << ".png\n";
     });
   }
+  // A textured mesh splits its vertices at chart seams; OBJ indexes
+  // positions and texture coordinates apart, so the positions are written
+  // welded (the file is the closed solid) and each corner keeps its own vt.
+  std::vector<uint32_t> pos_of(m.positions.size()), kept;
+  if (!m.uvs.empty()) {
+    pos_of = identical_positions(m, &kept);
+  } else {
+    for (uint32_t v = 0; v < pos_of.size(); ++v) pos_of[v] = v;
+    kept = pos_of;
+  }
   write_stream_atomically(path, [&](std::ostream& out) {
     std::string buf = "# written by voxpress\n";
     if (!m.texture.empty()) buf += "mtllib " + stem + ".mtl\nusemtl voxpress\n";
-    for (size_t v = 0; v < m.positions.size(); ++v) {
+    for (const uint32_t v : kept) {
       const Vec3& p = m.positions[v];
       buf += "v " + fmt(p.x()) + " " + fmt(p.y()) + " " + fmt(p.z());
       if (!m.colors.empty())
@@ -177,7 +187,7 @@ void write_obj(const std::string& path, const Mesh& m) {
       buf += "f";
       for (uint32_t i : m.triangles[order[k]]) {
         const std::string id = std::to_string(i + 1);
-        buf += " " + id;
+        buf += " " + std::to_string(pos_of[i] + 1);
         if (vt || vn) buf += "/" + (vt ? id : std::string()) + (vn ? "/" + id : std::string());
       }
       buf += "\n";
@@ -187,7 +197,8 @@ void write_obj(const std::string& path, const Mesh& m) {
       }
     }
     if (!m.edges.empty()) buf += "g sharp_edges\n";
-    for (const auto& e : m.edges) buf += "l " + std::to_string(e[0] + 1) + " " + std::to_string(e[1] + 1) + "\n";
+    for (const auto& e : m.edges)
+      buf += "l " + std::to_string(pos_of[e[0]] + 1) + " " + std::to_string(pos_of[e[1]] + 1) + "\n";
     out << buf;
   });
 }
@@ -278,6 +289,9 @@ Mesh read_gltf(const std::string& path, uint64_t max_bytes, bool binary) {
       }
     }
   if (m.triangles.empty()) throw InputError(path, "the glTF file holds no triangles");
+  // glTF has one index per corner for every attribute, so a textured mesh
+  // repeats its seam vertices; welded like STL's, the file reads as its solid.
+  weld_identical_vertices(m);
   m.validate(path);
   return m;
 }

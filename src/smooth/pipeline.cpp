@@ -75,7 +75,18 @@ void in_range(double value, double lo, double hi, const char* name) {
 // Iteration caps and ring counts beyond these only burn time (a ring count
 // of 12 already spans a whole small part).
 constexpr double kMaxIterations = 1e6, kMaxRings = 12;
+// Bytes per stick of the stages after extraction, at their peak (measured:
+// docs/RELIABILITY.md, Resource limits).
+constexpr uint64_t kFeatureBytesPerStick = 420, kPressBytesPerStick = 250, kOtherBytesPerStick = 320;
 }  // namespace
+
+uint64_t bytes_per_stick(const SurfaceOptions& o) {
+  // Peak resident bytes per stick beyond the volume and the bare surface,
+  // measured with /usr/bin/time on spheres and CAD parts at 256^3 and 512^3
+  // (docs/RELIABILITY.md, Resource limits), rounded up.
+  if (o.method != Method::pressing) return kOtherBytesPerStick;
+  return o.flats ? kFeatureBytesPerStick : kPressBytesPerStick;
+}
 
 void validate(const SurfaceOptions& o) {
   const MethodOverrides& ov = o.overrides;
@@ -155,6 +166,7 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   auto t0 = std::chrono::steady_clock::now();
   ExtractOptions eo = o.extract;
   if (o.progress) eo.progress = o.progress;
+  eo.later_bytes_per_stick = std::max(eo.later_bytes_per_stick, bytes_per_stick(o));
   StickSurface surface = extract_sticks(volume, eo, &r.extract);
   r.seconds_extract = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();

@@ -242,6 +242,9 @@ TEST(Cli, BadInputsFailCleanly) {
       {"extract " + tmp.path("mismatch.nrrd"), "mismatch.nrrd", "does not match", 1},
       {"extract " + tmp.path("huge.nrrd"), "huge.nrrd", "memory limit", 1},
       {"--max-memory 10K extract " + tmp.path("raw.nrrd"), "raw.nrrd", "memory limit", 1},
+      // The whole press's peak, not only the volume and the bare surface
+      // (which fit in 600 KiB here: this was accepted before).
+      {"--max-memory 600K press " + tmp.path("s.nrrd"), "s.nrrd", "its smoothing", 1},
       {"extract " + tmp.path("empty.nrrd"), "empty.nrrd", "empty", 1},
       {"extract " + tmp.path("full.nrrd"), "full.nrrd", "full", 1},
       {"check " + tmp.path("nope.ply"), "nope.ply", "no such file", 1},

@@ -310,6 +310,14 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
   expect_input_error([&] { read_volume(tmp.path("junk.nii")); }, "junk.nii", "NIfTI");
   test::write_file(tmp.path("junk.tif"), std::string(400, 'x'));
   expect_input_error([&] { read_volume(tmp.path("junk.tif")); }, "junk.tif", "TIFF");
+  // Text encoding with more values than declared; a detached header whose
+  // data file is missing names the header (and the missing file).
+  test::write_file(tmp.path("more.nrrd"),
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 1 1\nencoding: text\n\n1 0 1\n");
+  expect_input_error([&] { read_volume(tmp.path("more.nrrd")); }, "more.nrrd", "more than the 2 values");
+  test::write_file(tmp.path("lost.nhdr"),
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 1 1\nencoding: raw\ndata file: lost.raw\n");
+  expect_input_error([&] { read_volume(tmp.path("lost.nhdr")); }, "lost.nhdr", "lost.raw does not exist");
   // A multi-page TIFF cut anywhere (a page's data, its directory, a value
   // stored past it such as XResolution, the link to the next page) is an
   // error, never fewer slices or a default spacing (libtiff reads what it

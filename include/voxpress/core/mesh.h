@@ -61,10 +61,16 @@ struct Mesh {
   void validate(const std::string& source = {}) const;
 };
 
+/// For each vertex, the index of its position among the distinct ones (bit-
+/// identical positions, -0 = +0, numbered by first occurrence); `kept`
+/// receives the first vertex of each.
+std::vector<uint32_t> identical_positions(const Mesh& mesh, std::vector<uint32_t>* kept = nullptr);
+
 /// Merges vertices with bit-identical positions (STL stores every triangle's
-/// corners separately) and drops triangles that become degenerate
-/// (two equal indices). Vertex attributes of the first occurrence are kept.
-/// Returns the number of vertices removed.
+/// corners separately; a textured mesh splits its vertices at chart seams)
+/// and drops triangles that become degenerate (two equal indices). Vertex
+/// attributes (and texture coordinates) of the first occurrence are kept;
+/// edges are renumbered. Returns the number of vertices removed.
 size_t weld_identical_vertices(Mesh& mesh);
 
 /// Per-vertex unit normals: area-weighted mean of the adjacent face normals.

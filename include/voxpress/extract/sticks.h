@@ -51,6 +51,10 @@ struct StickSurface {
 struct ExtractOptions {
   Progress* progress = nullptr;  ///< optional progress sink and cancellation
   uint64_t max_bytes = 0;        ///< refuse (LimitError) if the output would exceed this; 0 = no cap
+  /// What the caller's later stages need per stick (smooth_surface: its
+  /// method's measured peak), counted against max_bytes with the volume and
+  /// the surface, so a run that cannot fit is refused before any work on it.
+  uint64_t later_bytes_per_stick = 0;
 };
 
 struct ExtractStats {

@@ -87,6 +87,10 @@ struct SurfaceResult {
 /// the CLI and the Python module share. smooth_surface calls it.
 void validate(const SurfaceOptions& options);
 
+/// Peak bytes per stick of `options`' stages after extraction (the memory
+/// model smooth_surface checks against options.extract.max_bytes).
+uint64_t bytes_per_stick(const SurfaceOptions& options);
+
 /// The volume's smooth surface by `options.method`. Throws InputError for an
 /// empty or full volume, UsageError for invalid options, LimitError when
 /// options.extract.max_bytes would be exceeded.
