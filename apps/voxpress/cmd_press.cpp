@@ -102,7 +102,6 @@ void write_features(const std::string& path, const Mesh& mesh) {
 void run_press(const PressCmd& c, const Global& g) {
   check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.features, OutputKind::features}, {c.stats_json, OutputKind::json}});
 
-  mesh_format_from_path(c.output);  // a bad extension fails before any work
   SurfaceOptions so;
   so.method = parse_method(c.method);
   const bool pressing = so.method == Method::pressing;
@@ -113,11 +112,8 @@ void run_press(const PressCmd& c, const Global& g) {
           "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain", "--circle-correction",
           "--fixed-ends", "--no-curved-creases", "--fit-rings"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
-  if (!c.features.empty()) {
-    const MeshFormat ff = mesh_format_from_path(c.features);
-    if (ff != MeshFormat::ply && ff != MeshFormat::obj) throw UsageError("--features must be a .ply or .obj file");
-    if (c.no_flats || c.no_sharpen) throw UsageError("--features needs sharpening (drop --no-flats / --no-sharpen)");
-  }
+  if (!c.features.empty() && (c.no_flats || c.no_sharpen))
+    throw UsageError("--features needs sharpening (drop --no-flats / --no-sharpen)");
   if (!(c.sharpen.sharp_angle >= 0 && c.sharpen.sharp_angle <= 180)) throw UsageError("--sharp-angle must be in [0, 180]");
   so.press = c.smooth.resolve();
   if (!(c.flats.min_area >= 0)) throw UsageError("--min-flat-area must be >= 0");

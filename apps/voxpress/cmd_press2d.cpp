@@ -17,9 +17,6 @@ struct Press2dCmd {
 void run_press2d(const Press2dCmd& c, const Global& g) {
   check_paths({c.input}, {{c.output, OutputKind::svg}, {c.stats_json, OutputKind::json}});
 
-  std::string ext = std::filesystem::path(c.output).extension().string();
-  for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  if (ext != ".svg") throw UsageError(c.output + ": press2d writes SVG (.svg)");
   const PressOptions o = c.smooth.resolve();
   const GreyImage img = read_image(c.input, g.memory_limit());
   std::vector<uint8_t> inside(img.value.size());

@@ -18,7 +18,6 @@ struct VoxartCmd {
 void run_voxart(VoxartCmd c, const Global& g) {
   check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.stats_json, OutputKind::json}});
 
-  mesh_format_from_path(c.output);  // a bad extension fails before any work
   c.options.fairing = parse_voxart_fairing(c.fairing);
   c.options.packer = parse_atlas_packer(c.packer);
   c.options.texture = !c.no_texture;

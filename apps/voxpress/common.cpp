@@ -4,7 +4,6 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -262,15 +261,6 @@ nlohmann::json lattice_json(const Lattice& l) {
 }
 
 namespace {
-std::string lower_ext(const std::string& path) {
-  std::string name = std::filesystem::path(path).filename().string();
-  for (char& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  for (const char* two : {".nii.gz", ".seg.nrrd"})
-    if (name.ends_with(two)) return two;
-  const size_t dot = name.rfind('.');
-  return dot == std::string::npos ? "" : name.substr(dot);
-}
-
 // The same file: by identity when both exist, by their absolute, normal
 // paths otherwise.
 bool same_file(const std::string& a, const std::string& b) {
@@ -297,7 +287,7 @@ void check_paths(const std::vector<std::string>& inputs,
     if (path.empty()) continue;
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UsageError(path + ": is a folder; give a file name for the output");
-    const std::string ext = lower_ext(path);
+    const std::string ext = file_extension(path);
     auto known = [&](std::initializer_list<const char*> exts) {
       for (const char* e : exts)
         if (ext == e) return true;

@@ -187,7 +187,8 @@ void write_obj(const std::string& path, const Mesh& m) {
       buf += "f";
       for (uint32_t i : m.triangles[order[k]]) {
         const std::string id = std::to_string(i + 1);
-        buf += " " + std::to_string(pos_of[i] + 1);
+        buf += ' ';  // appended, not " " + ...: GCC 12 warns falsely (-Wrestrict) on that
+        buf += std::to_string(pos_of[i] + 1);
         if (vt || vn) buf += "/" + (vt ? id : std::string()) + (vn ? "/" + id : std::string());
       }
       buf += "\n";

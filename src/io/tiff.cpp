@@ -94,29 +94,33 @@ PageInfo page_info(const std::string& path, TIFF* t) {
 // inside the file (libtiff drops a value it cannot read, such as a cut
 // XResolution, without an error, and the spacing would default to 1).
 void check_directory_in_file(const std::string& path, TIFF* t, tdir_t page, uint64_t file_bytes) {
-  const bool big = TIFFIsBigTIFF(t), swapped = TIFFIsByteSwapped(t);
-  auto number = [&](uint64_t at, size_t width) {
-    if (at > file_bytes || width > file_bytes - at)
-      throw InputError(path, "truncated TIFF: page " + std::to_string(page) + "'s directory runs past the end of the file");
-    const auto b = read_range(path, at, width);
+  const bool big = TIFFIsBigTIFF(t);
+  const bool little = TIFFIsByteSwapped(t) != (std::endian::native == std::endian::little);  // the file's order
+  auto truncated = [&] {
+    return InputError(path, "truncated TIFF: page " + std::to_string(page) + "'s directory runs past the end of the file");
+  };
+  auto decode = [&](const std::byte* b, size_t width) {
     uint64_t v = 0;
-    for (size_t i = 0; i < width; ++i) {
-      const size_t k = swapped != (std::endian::native == std::endian::little) ? width - 1 - i : i;  // little-endian file
-      v = (v << 8) | uint64_t(std::to_integer<uint8_t>(b[k]));
-    }
+    for (size_t i = 0; i < width; ++i) v = (v << 8) | uint64_t(std::to_integer<uint8_t>(b[little ? width - 1 - i : i]));
     return v;
   };
+  // The directory: its entry count, then the entries and the link to the
+  // next page, each read once.
   const uint64_t dir = TIFFCurrentDirOffset(t);
-  const size_t count_width = big ? 8 : 2, entry = big ? 20 : 12, inline_bytes = big ? 8 : 4;
-  const uint64_t entries = number(dir, count_width);
-  number(dir + count_width + entries * entry, big ? 8 : 4);  // the link to the next page
+  const size_t count_width = big ? 8 : 2, entry = big ? 20 : 12, word = big ? 8 : 4;
+  if (dir > file_bytes || count_width > file_bytes - dir) throw truncated();
+  const uint64_t entries = decode(read_range(path, dir, count_width).data(), count_width);
+  if (entries > (file_bytes - dir - count_width) / entry) throw truncated();
+  const uint64_t block = entries * entry + word;
+  if (block > file_bytes - dir - count_width) throw truncated();
+  const auto bytes = read_range(path, dir + count_width, block);
+  static constexpr uint8_t kTypeBytes[19] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4, 0, 0, 8, 8, 8};
   for (uint64_t e = 0; e < entries; ++e) {
-    const uint64_t at = dir + count_width + e * entry;
-    const uint64_t type = number(at + 2, 2), n = number(at + 4, big ? 8 : 4);
-    static constexpr uint8_t kTypeBytes[19] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4, 0, 0, 8, 8, 8};
+    const std::byte* at = bytes.data() + e * entry;
+    const uint64_t type = decode(at + 2, 2), n = decode(at + 4, word);
     const uint64_t width = type < 19 ? kTypeBytes[type] : 0;
-    if (width == 0 || n == 0 || n > file_bytes / width || n * width <= inline_bytes) continue;
-    const uint64_t value_at = number(at + 4 + (big ? 8 : 4), big ? 8 : 4);
+    if (width == 0 || n == 0 || n > file_bytes / width || n * width <= word) continue;  // stored inline
+    const uint64_t value_at = decode(at + 4 + word, word);
     if (value_at > file_bytes || n * width > file_bytes - value_at)
       throw InputError(path, "truncated TIFF: a value of page " + std::to_string(page) + " lies past the end of the file");
   }

@@ -97,6 +97,8 @@ ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t
 
 }  // namespace detail
 
+std::string file_extension(const std::string& path) { return detail::extension_of(path); }
+
 ScalarVolume read_volume(const std::string& path, const ReadOptions& options) {
   const uint64_t cap = options.max_bytes ? options.max_bytes : default_memory_limit();
   if (options.raw) return detail::read_raw(path, *options.raw, cap);

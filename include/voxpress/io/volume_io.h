@@ -52,6 +52,11 @@ uint64_t parse_byte_size(const std::string& text);
 ScalarType parse_scalar_type(const std::string& name);
 
 /// Reads a volume; the format follows from the extension (or options.raw).
+/// A path's lower-case extension, the compound ones (.nii.gz, .seg.nrrd,
+/// .seg.nhdr) whole, "" when it has none: the rule every reader and writer
+/// dispatches on.
+std::string file_extension(const std::string& path);
+
 ScalarVolume read_volume(const std::string& path, const ReadOptions& options = {});
 
 struct WriteVolumeOptions {
