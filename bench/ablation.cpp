@@ -1,10 +1,10 @@
-// One table-driven ablation of the feature layer: every rule beyond the
-// paper switched off alone (and the whole layer off), on CAD, freeform and
+// One table-driven ablation of the feature layer: every pass of
+// voxpress/features/passes.h switched off alone, on CAD, freeform and
 // organic cases over several rotations, against the default press. It
 // replaces the per-rule tests that compared one rule on and off on a seed or
 // two (their claims are figures, and figures belong here, not in ctest).
 //   build/bench/bench_ablation                       # the table in docs/BENCHMARKS.md
-//   build/bench/bench_ablation --seeds 1,2,3 --res 128 --rules past_crease,snap
+//   build/bench/bench_ablation --seeds 1,2,3 --res 128 --passes past-crease,snap
 //   build/bench/bench_ablation --cases cad-part,fandisk
 // Columns per case: result -> truth RMS (voxels), mean normal error
 // (degrees), sharp-edge Hausdorff (voxels, true <-> labelled, where the
@@ -14,7 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
+#include <optional>
 #include <sstream>
 
 #include "voxpress/eval/metrics.h"
@@ -26,46 +26,17 @@ using namespace voxpress;
 
 namespace {
 
+// The rows: the default, then each pass of the feature layer off alone
+// (voxpress/features/passes.h: `flats` off is the whole layer, `sharpen`
+// off keeps the chamfers).
 struct Rule {
-  const char* name;
-  const char* what;
-  std::function<void(SurfaceOptions&)> off;
+  std::string name, what;
+  std::optional<Pass> off;
 };
 
-// Every public switch of a rule beyond the paper, and the layers as a whole.
-const std::vector<Rule>& rules() {
-  static const std::vector<Rule> r = {
-      {"default", "every rule on", [](SurfaceOptions&) {}},
-      {"no-flats", "the whole feature layer off (--no-flats)", [](SurfaceOptions& o) { o.flats = false; }},
-      {"no-sharpen", "flats, no sharpening (--no-sharpen)", [](SurfaceOptions& o) { o.sharpen = false; }},
-      {"stab_refit", "flats: core planes refit by stabbed sticks", [](SurfaceOptions& o) { o.flat.stab_refit = false; }},
-      {"crease_refit", "flats: planes refit along their creases", [](SurfaceOptions& o) { o.flat.crease_refit = false; }},
-      {"center_planes", "flats: centred planes", [](SurfaceOptions& o) { o.flat.center_planes = false; }},
-      {"crease_rounds", "flats: curved side placed by its quadric", [](SurfaceOptions& o) { o.flat.crease_rounds = 0; }},
-      {"rim_tangent", "flats: the rim leaves tangent fillets", [](SurfaceOptions& o) { o.flat.rim_tangent_angle = 0; }},
-      {"ring_off_plane", "flats: junction test without the stopped rim",
-       [](SurfaceOptions& o) { o.flat.junction_ring_off_plane = 0; }},
-      {"curved_creases", "creases between curved faces",
-       [](SurfaceOptions& o) { o.flat.curved_creases = o.sharp.curved_creases = false; }},
-      {"free_ends", "pressing: open curve pieces at barriers", [](SurfaceOptions& o) { o.press.free_ends = false; }},
-      {"snap", "sharpen: bands snapped onto the flats", [](SurfaceOptions& o) { o.sharp.snap_rings = 0; }},
-      {"strips", "sharpen: thin strips join a flat", [](SurfaceOptions& o) { o.sharp.strip_rings = 0; }},
-      {"rim_pockets", "sharpen: rim pockets stay curved", [](SurfaceOptions& o) { o.sharp.rim_pockets = false; }},
-      {"tangent_plane", "sharpen: curved side's quadric tangent plane",
-       [](SurfaceOptions& o) { o.sharp.curved_fit_rings = 0; }},
-      {"walls", "sharpen: thin walls get their own plane", [](SurfaceOptions& o) { o.sharp.wall_thickness = 0; }},
-      {"final_crease", "sharpen: final crease fit", [](SurfaceOptions& o) { o.sharp.final_crease_rings = 0; }},
-      {"past_crease", "sharpen: vertices past the crease change sides",
-       [](SurfaceOptions& o) { o.sharp.past_crease = false; }},
-      {"inherit_junctions", "sharpen: joined junctions pass the border on",
-       [](SurfaceOptions& o) { o.sharp.inherit_junctions = false; }},
-      {"on_plane_bands", "sharpen: on-plane bands join their flat",
-       [](SurfaceOptions& o) { o.sharp.on_plane_bands = false; }},
-      {"sample_wedges", "sharpen: chamfer planes agree with their samples",
-       [](SurfaceOptions& o) { o.sharp.sample_wedges = false; }},
-      {"retry_right_angle", "sharpen: right-angle crease moves retried",
-       [](SurfaceOptions& o) { o.sharp.retry_right_angle = -1; }},
-  };
+std::vector<Rule> rules() {
+  std::vector<Rule> r = {{"default", "every pass on", std::nullopt}};
+  for (const PassInfo& p : feature_passes()) r.push_back({p.name, std::string(p.section) + ": " + p.what, p.pass});
   return r;
 }
 
@@ -127,15 +98,16 @@ int main(int argc, char** argv) {
   app.add_option("--cases", cases_arg, "Generated shapes and ../shared/data/meshes models")->capture_default_str();
   app.add_option("--seeds", seeds_arg, "Rotations (random:N)")->capture_default_str();
   app.add_option("--res", res, "Resolution")->capture_default_str();
-  app.add_option("--rules", rules_arg, "Only these rules (default and no-flats always run)");
+  app.add_option("--passes", rules_arg, "Only these passes (default and flats always run)");
   app.add_option("--data", data, "The shared data folder")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   std::vector<int> seeds;
   for (const auto& s : split(seeds_arg)) seeds.push_back(std::stoi(s));
   const auto only = split(rules_arg);
+  const std::vector<Rule> all = rules();
   std::vector<const Rule*> chosen;
-  for (const Rule& r : rules())
-    if (only.empty() || std::string(r.name) == "default" || std::string(r.name) == "no-flats" ||
+  for (const Rule& r : all)
+    if (only.empty() || r.name == "default" || r.name == "flats" ||
         std::find(only.begin(), only.end(), r.name) != only.end())
       chosen.push_back(&r);
   const auto cases = split(cases_arg);
@@ -146,7 +118,7 @@ int main(int argc, char** argv) {
       const Case c = make_case(cases[ci], res, seed, data);
       for (size_t ri = 0; ri < chosen.size(); ++ri) {
         SurfaceOptions so;
-        chosen[ri]->off(so);
+        if (chosen[ri]->off) so.passes.disable(*chosen[ri]->off);
         const SurfaceResult r = smooth_surface(c.volume, so);
         EvalOptions eo;
         eo.volume = &c.volume;
@@ -163,19 +135,19 @@ int main(int argc, char** argv) {
         if (!mc.ok() || violations)
           f.failures.push_back(cases[ci] + " seed " + std::to_string(seed) + ": " +
                                (mc.ok() ? std::to_string(violations) + " violations" : mc.problems[0]));
-        std::fprintf(stderr, "%s seed %d %s: r->t %.4f\n", cases[ci].c_str(), seed, chosen[ri]->name,
+        std::fprintf(stderr, "%s seed %d %s: r->t %.4f\n", cases[ci].c_str(), seed, chosen[ri]->name.c_str(),
                      e.result_to_truth_vox.rms);
       }
     }
   std::printf("res %ld, seeds %s; per case: r->t RMS (vox) / normal error (deg) / sharp H (vox) / labelled sharp "
-              "edges, means over the seeds; [x%%]: r->t RMS change against the default\n\n| rule | off |",
+              "edges, means over the seeds; [x%%]: r->t RMS change against the default\n\n| pass off | what it does |",
               long(res), seeds_arg.c_str());
   for (const auto& c : cases) std::printf(" %s |", c.c_str());
   std::printf("\n|---|---|");
   for (size_t i = 0; i < cases.size(); ++i) std::printf("---|");
   std::printf("\n");
   for (size_t ri = 0; ri < chosen.size(); ++ri) {
-    std::printf("| %s | %s |", chosen[ri]->name, chosen[ri]->what);
+    std::printf("| %s | %s |", chosen[ri]->name.c_str(), chosen[ri]->what.c_str());
     for (size_t ci = 0; ci < cases.size(); ++ci) {
       const Figures& f = figures[ri][ci];
       const Figures& d = figures[0][ci];
@@ -195,6 +167,6 @@ int main(int argc, char** argv) {
   bool ok = true;
   for (size_t ri = 0; ri < chosen.size(); ++ri)
     for (const auto& fs : figures[ri])
-      for (const auto& msg : fs.failures) std::printf("CHECK FAILED (%s): %s\n", chosen[ri]->name, msg.c_str()), ok = false;
+      for (const auto& msg : fs.failures) std::printf("CHECK FAILED (%s): %s\n", chosen[ri]->name.c_str(), msg.c_str()), ok = false;
   return ok ? 0 : 1;
 }

@@ -200,19 +200,10 @@ int main(int argc, char** argv) try {
   app.add_option("--iterations", iterations);
   app.add_option("--rotate", rotate, "One fixed rotation (AX,AY,AZ degrees, e.g. 0,0,0) instead of random:SEED; one case per job");
   app.add_option("--min-flat-area", fo.min_area);
-  app.add_option("--flat-bend", fo.max_bend);
-  app.add_option("--flat-tolerance", fo.tolerance);
-  app.add_option("--flat-width", fo.min_width);
-  app.add_option("--flat-spread", fo.max_spread);
-  app.add_option("--flat-passes", fo.passes);
-  app.add_flag("!--no-stab-refit", fo.stab_refit, "Without the flats' stabbing refit (near-axis faces)");
-  app.add_option("--merge-angle", fo.merge_angle, "Degrees: adjacent flats this close are merged when one plane stabs both (0: off)");
-  app.add_option("--curved-gain", fo.curved_gain, "Flats' curvature test: refuse a flat a quadric out-stabs this many times (0: off)");
-  app.add_option("--rim-tangent-angle", fo.rim_tangent_angle,
-                 "Flats: degrees within which a curved side continuing a flat takes its rim back (0: off)");
-  app.add_flag("!--no-crease-refit", fo.crease_refit, "Without the flats' crease refit (their creases' samples as constraints)");
-  app.add_flag("!--no-center", fo.center_planes, "Final planes by least squares of the estimate, not centred in their feasible set");
+  std::vector<std::string> disabled;
+  app.add_option("--disable-pass", disabled, "Feature passes to switch off (voxpress press --help lists them)")->delimiter(',');
   CLI11_PARSE(app, argc, argv);
+  for (const std::string& name : disabled) fo.passes.disable(name);
   struct Job {
     std::string shape, model;
     int64_t res;

@@ -150,12 +150,16 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
     const std::string k = py::str(key);
     if (k == "iterations") o.overrides.iterations = value.cast<int>();
     else if (k == "tolerance") o.overrides.tolerance = value.cast<double>();
-    else if (k == "flats") o.flats = value.cast<bool>();
-    else if (k == "sharpen") o.sharpen = value.cast<bool>();
+    else if (k == "flats") {
+      if (!value.cast<bool>()) o.passes.disable(Pass::flats);
+    } else if (k == "sharpen") {
+      if (!value.cast<bool>()) o.passes.disable(Pass::sharpen);
+    } else if (k == "disable_passes") {
+      for (const auto& name : value.cast<std::vector<std::string>>()) o.passes.disable(name);
+    }
     else if (k == "min_flat_area") o.flat.min_area = value.cast<double>();
     else if (k == "junction_angle") o.flat.junction_angle = value.cast<double>();
     else if (k == "sharp_angle") o.sharp.sharp_angle = value.cast<double>();
-    else if (k == "wall_thickness") o.sharp.wall_thickness = value.cast<double>();
     else if (k == "color_regions") o.color_regions = value.cast<bool>();
     else if (k == "fit_rings") o.fit.rings = value.cast<int>();
     else if (k == "lambda_") o.overrides.lambda = value.cast<double>();
@@ -163,7 +167,7 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
     else
       throw py::type_error("press() got an unknown option '" + k +
                            "' (iterations, tolerance, flats, sharpen, min_flat_area, junction_angle, sharp_angle, "
-                           "wall_thickness, color_regions, fit_rings, lambda_, mu)");
+                           "disable_passes, color_regions, fit_rings, lambda_, mu)");
   }
 }
 

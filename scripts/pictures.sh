@@ -18,9 +18,9 @@ mkdir -p "$img"
 "$vp" render "$work/part-midpoint.ply" "$work/part-pressed.ply" --color regions --size 480x400 -o "$img/cad-part.png"
 
 # A plate 3 cells thick (examples/plate.obj at 64^3): one crease along the middle of its rim without
-# the thin walls (--wall-thickness 0) vs the rim's own plane and both of its edges.
+# the thin walls (--disable-pass walls) vs the rim's own plane and both of its edges.
 "$vp" -q voxelize "$root/examples/plate.obj" --res 64 --rotate random:3 -o "$work/plate.nrrd"
-"$vp" -q press "$work/plate.nrrd" -o "$work/plate-no-walls.ply" --wall-thickness 0
+"$vp" -q press "$work/plate.nrrd" -o "$work/plate-no-walls.ply" --disable-pass walls
 "$vp" -q press "$work/plate.nrrd" -o "$work/plate-walls.ply"
 "$vp" render "$work/plate-no-walls.ply" "$work/plate-walls.ply" --color regions --size 480x400 -o "$img/thin-plate.png"
 

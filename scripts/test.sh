@@ -37,7 +37,7 @@ Sharpen.JoinedVerticesTakeTheNearestPlane:Sharpen.FandiskGetsMoreAccurate:\
 Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Pressing.QuadricFitBringsTightCurvesCloserToTheTruth:\
 Metrics.MidpointRowOfThePaperIsReproduced:Shapes.CadPartMeshIsAValidSolidMatchingItsClosedFormVolume:\
 Written.RotatedRealMeshKeepsTheGuaranteeInEveryFormat:\
-Written.AnisotropicPartFarFromTheOriginKeepsTheGuaranteeInEveryFormat:Flats.FaceSplitInTwoFlatsIsMerged"
+Written.AnisotropicPartFarFromTheOriginKeepsTheGuaranteeInEveryFormat:Passes.EachPassOffKeepsTheGuarantees"
 # smooth_tests, the longest, runs as two shards.
 runs=(smooth_tests:0:2 smooth_tests:1:2)
 for s in "${suites[@]}"; do if [ "$s" != smooth_tests ]; then runs+=("$s:0:1"); fi; done

@@ -15,7 +15,8 @@ struct PressCmd {
   SharpenOptions sharpen;
   QuadricFitOptions fit;
   std::string features;
-  bool no_flats = false, no_sharpen = false, no_curved_creases = false, color_regions = false;
+  std::vector<std::string> disabled_passes;
+  bool no_flats = false, no_sharpen = false, color_regions = false;
   bool ascii = false, check = false;
   std::string method = "pressing";
   MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
@@ -65,8 +66,6 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"past_crease", st.past_crease},
           {"left_flat", st.left_flat},
           {"inherited_junctions", st.inherited_junctions},
-          {"band_joins", st.band_joins},
-          {"band_junctions", st.band_junctions},
           {"wedge_checks", st.wedge_checks},
           {"wedge_shifts", st.wedge_shifts},
           {"wall_vertices", st.wall_vertices},
@@ -76,8 +75,20 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"cut_back", st.cut_back},
           {"sharp_edges", st.sharp_edges},
           {"sharp_angle", o.sharp_angle},
-          {"chain_iterations", o.chain_iterations},
           {"seconds", st.seconds}};
+}
+
+// The feature layer's pass table as run: name, paper section, on/off,
+// seconds and the pass's own count (vertices placed, flats found, ...).
+nlohmann::json passes_json(const PassSet& on, const PassTimes& t) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const PassInfo& p : feature_passes())
+    list.push_back({{"name", p.name},
+                    {"section", p.section},
+                    {"enabled", on.on(p.pass)},
+                    {"seconds", t.seconds[size_t(p.pass)]},
+                    {"count", t.count[size_t(p.pass)]}});
+  return list;
 }
 
 // The sharp feature curves alone: their vertices and edges, no faces.
@@ -107,26 +118,19 @@ void run_press(const PressCmd& c, const Global& g) {
   const bool pressing = so.method == Method::pressing;
   if (!pressing)
     for (const char* name :
-         {"--no-flats", "--min-flat-area", "--junction-angle", "--flat-tolerance", "--flat-bend", "--flat-width",
-          "--color-regions", "--no-sharpen", "--sharp-angle", "--chain-iterations", "--wall-thickness", "--features",
-          "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting", "--plain", "--circle-correction",
-          "--fixed-ends", "--no-curved-creases", "--fit-rings"})
+         {"--no-flats", "--min-flat-area", "--junction-angle", "--color-regions", "--no-sharpen", "--sharp-angle",
+          "--features", "--disable-pass", "--step", "--arc-length", "--margin", "--levels", "--momentum", "--weighting",
+          "--plain", "--circle-correction", "--fixed-ends", "--fit-rings"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " applies to --method pressing only");
-  if (!c.features.empty() && (c.no_flats || c.no_sharpen))
-    throw UsageError("--features needs sharpening (drop --no-flats / --no-sharpen)");
-  if (!(c.sharpen.sharp_angle >= 0 && c.sharpen.sharp_angle <= 180)) throw UsageError("--sharp-angle must be in [0, 180]");
   so.press = c.smooth.resolve();
-  if (!(c.flats.min_area >= 0)) throw UsageError("--min-flat-area must be >= 0");
-  if (!(c.flats.junction_angle >= 0 && c.flats.junction_angle <= 180)) throw UsageError("--junction-angle must be in [0, 180]");
-  if (!(c.flats.tolerance > 0) || !(c.flats.max_bend > 0) || !(c.flats.min_width >= 0))
-    throw UsageError("--flat-tolerance and --flat-bend must be > 0, --flat-width >= 0");
-  so.flats = !c.no_flats;
   so.flat = c.flats;
-  so.flat.curved_creases = !c.no_curved_creases;
   so.fit = c.fit;
-  so.sharpen = !c.no_sharpen;
   so.sharp = c.sharpen;
-  so.sharp.curved_creases = !c.no_curved_creases;
+  if (c.no_flats) so.passes.disable(Pass::flats);
+  if (c.no_sharpen) so.passes.disable(Pass::sharpen);
+  for (const std::string& name : c.disabled_passes) so.passes.disable(name);
+  if (!c.features.empty() && !(so.passes.on(Pass::flats) && so.passes.on(Pass::sharpen)))
+    throw UsageError("--features needs sharpening (drop --no-flats / --no-sharpen / --disable-pass flats|sharpen)");
   so.color_regions = c.color_regions;
   if (!pressing) {  // pressing reads these from so.press, with its own defaults
     if (c.smooth.iterations_option->count()) so.overrides.iterations = c.smooth.options.iterations;
@@ -168,9 +172,11 @@ void run_press(const PressCmd& c, const Global& g) {
     j["method"] = c.method;
     if (pressing) {
       j["pressing"] = press_stats_json(r.press, so.press);
-      if (so.flats) j["flats"] = flats_json(r.flats, so.flat);
+      const bool features = so.passes.on(Pass::flats);
+      if (features) j["flats"] = flats_json(r.flats, so.flat);
       j["quadric_fit"] = {{"rings", so.fit.rings}, {"fitted", r.fit.fitted}, {"moved", r.fit.moved}};
-      if (so.flats && so.sharpen) j["sharpen"] = sharpen_json(r.sharpen, so.sharp);
+      if (features && so.passes.on(Pass::sharpen)) j["sharpen"] = sharpen_json(r.sharpen, so.sharp);
+      j["passes"] = passes_json(so.passes, r.pass_times);
       j["seconds"] = {{"read", seconds_read}, {"extract", r.seconds_extract}, {"press", r.press.seconds},
                       {"quadric_fit", r.fit.seconds}, {"sharpen", r.sharpen.seconds}, {"total", clock.seconds()}};
     } else {
@@ -214,44 +220,26 @@ void register_press(CLI::App& app, Global& g) {
   bind_fairing(*cmd->add_option_group("fairing", "Taubin / Laplacian (--method taubin|laplacian)"), c->overrides);
   auto* f = cmd->add_option_group("flats", "Flats (plane voting) and junctions");
   f->add_flag("--no-flats", c->no_flats, "Do not look for flats: every vertex is smoothed");
-  f->add_option("--min-flat-area", c->flats.min_area, "Smallest flat, in cell areas")->capture_default_str();
+  f->add_option("--min-flat-area", c->flats.min_area, "Smallest flat, in cell areas")
+      ->check(CLI::Range(0.0, 1e12))
+      ->capture_default_str();
   f->add_option("--junction-angle", c->flats.junction_angle,
                 "Degrees between a flat and its curved neighbour above which their border is sharp")
+      ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
-  f->add_option("--flat-tolerance", c->flats.tolerance, "Cells: how close to its plane a flat's surface must be")
-      ->capture_default_str();
-  f->add_option("--flat-bend", c->flats.max_bend, "Degrees: largest normal change across a flat")->capture_default_str();
-  f->add_option("--flat-width", c->flats.min_width, "Cells: narrowest flat")->capture_default_str();
-  f->add_option("--flat-passes", c->flats.passes,
-                "Detection passes (each after the next estimate, pressed with the previous pass's flats frozen)")
-      ->check(CLI::Range(1, 8))
-      ->capture_default_str();
-  f->add_option("--crease-rounds", c->flats.crease_rounds,
-                "Rounds placing the curved vertices next to a sharp flat border by the curved side's quadric fit (0: off)")
-      ->check(CLI::Range(0, 8))
-      ->capture_default_str();
-  f->add_flag("--no-curved-creases", c->no_curved_creases,
-              "Leave creases between two curved faces rounded and unlabelled (they are placed by both sides' quadric "
-              "fits and sharpened by default)");
   f->add_flag("--color-regions", c->color_regions,
               "Colour the vertices by region (flats, curved grey, junctions orange, sharp curves red)");
   auto* sh = cmd->add_option_group("sharpen", "Sharp edge recovery (needs flats)");
   sh->add_flag("--no-sharpen", c->no_sharpen, "Keep the chamfers: do not insert the sharp edges");
   sh->add_option("--sharp-angle", c->sharpen.sharp_angle, "Degrees between two faces above which their crease is labelled sharp")
+      ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
-  sh->add_option("--chain-iterations", c->sharpen.chain_iterations, "Bilaplacian iterations along the sharp curves")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 100000));
-  sh->add_option("--wall-thickness", c->sharpen.wall_thickness,
-                 "Cells: the rim of a plate at most this thick (between two opposite flats) gets its own plane, so "
-                 "both its edges are sharpened (0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 64.0));
-  sh->add_option("--final-crease-rings", c->sharpen.final_crease_rings,
-                 "Curved vertices up to this many rings from a sharp flat border are placed again by the curved "
-                 "side's quadric fit once the regions are final (0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 8));
+  std::string pass_names;
+  for (const PassInfo& p : feature_passes()) pass_names += std::string(pass_names.empty() ? "" : ", ") + p.name;
+  cmd->add_option("--disable-pass", c->disabled_passes,
+                  "Switch off a pass of the feature layer (repeat or comma-separate; docs/ARCHITECTURE.md, "
+                  "Passes): " + pass_names)
+      ->delimiter(',');
   sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");

@@ -27,7 +27,7 @@ from ._voxpress import (  # noqa: F401
 
 def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, method="pressing",
           axes="xyz", label=None, threshold=None, iterations=None, tolerance=None, flats=None, sharpen=None,
-          min_flat_area=None, junction_angle=None, sharp_angle=None, wall_thickness=None, color_regions=None,
+          min_flat_area=None, junction_angle=None, sharp_angle=None, disable_passes=None, color_regions=None,
           fit_rings=None, lambda_=None, mu=None):
     """The smooth surface of a 3-D mask, as `voxpress press` computes it; returns a Mesh.
 
@@ -45,14 +45,17 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
       iterations, tolerance  the smoothing's cap (pressing: 100) and stop (1e-4)
       flats (True), sharpen (True)  plane voting and sharp-edge recovery (pressing)
       min_flat_area (100 cells), junction_angle (30 deg), sharp_angle (30 deg),
-      wall_thickness (24 cells), color_regions (False), fit_rings (5)
+      color_regions (False), fit_rings (5)
+      disable_passes  names of feature-layer passes to switch off, e.g.
+                     ["curved-creases"] (the list: voxpress press --help)
       lambda_, mu  Taubin / Laplacian steps
     Out-of-range values raise UsageError with the command line's message; the
     GIL is released while it works.
     """
     options = dict(iterations=iterations, tolerance=tolerance, flats=flats, sharpen=sharpen,
                    min_flat_area=min_flat_area, junction_angle=junction_angle, sharp_angle=sharp_angle,
-                   wall_thickness=wall_thickness, color_regions=color_regions, fit_rings=fit_rings,
+                   disable_passes=None if disable_passes is None else list(disable_passes),
+                   color_regions=color_regions, fit_rings=fit_rings,
                    lambda_=lambda_, mu=mu)
     return _voxpress.press(mask, spacing=spacing, origin=origin, direction=direction, method=method, axes=axes,
                            label=label, threshold=threshold,

@@ -68,7 +68,7 @@ def press(
     min_flat_area: float = 100,
     junction_angle: float = 30,
     sharp_angle: float = 30,
-    wall_thickness: float = 24,
+    disable_passes: Optional[Sequence[str]] = None,
     color_regions: bool = False,
     lambda_: float = ...,
     mu: float = ...,

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "crease_fit.h"
+#include "feature_tuning.h"
 #include "quadric.h"
 #include "surface_graph.h"
 #include "voxpress/smooth/flats.h"
@@ -238,13 +239,13 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
 size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o, std::vector<uint8_t>* zone) {
   const size_t n = s.stick_count();
   if (zone) zone->assign(n, 0);
-  if (seg.flats.empty() || o.crease_rings < 0) return 0;
+  if (seg.flats.empty() || !o.passes.on(Pass::crease_fit)) return 0;
   std::vector<uint32_t> off, adj;
   detail::vertex_adjacency(n, s.triangles, off, adj);
   std::vector<Vec3> x(n);
   tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
   const detail::CreaseFit c{
-      .rings = o.crease_rings, .fit_rings = o.crease_fit_rings, .residual = o.crease_residual, .margin = o.margin};
+      .rings = detail::kCreaseRings, .fit_rings = detail::kCreaseFitRings, .residual = detail::kCreaseResidual, .margin = o.margin};
   const auto targets = detail::crease_targets(s, seg.flats, seg.region, seg.junction, x, off, adj, c);
   for (const auto& [v, t] : targets) {
     s.t[v] = s.lower_inside(v) ? t : 1 - t;
@@ -256,7 +257,7 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
 size_t fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o,
                           std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed) {
   const size_t n = s.stick_count();
-  if (!o.curved_creases || seg.region.size() != n) return 0;
+  if (!o.passes.on(Pass::curved_creases) || seg.region.size() != n) return 0;
   std::vector<uint32_t> off, adj;
   detail::vertex_adjacency(n, s.triangles, off, adj);
   std::vector<Vec3> x(n);

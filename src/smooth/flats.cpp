@@ -6,6 +6,7 @@
 #include "voxpress/smooth/flats.h"
 
 #include "core/timing.h"
+#include "feature_tuning.h"
 #include "quadric.h"
 #include "surface_graph.h"
 
@@ -32,6 +33,11 @@ namespace voxpress {
 using detail::seconds_since;
 
 namespace {
+
+// The narrowest flat: a share of the smallest flat's side, capped (cells).
+double min_width(const FlatOptions& o) {
+  return std::min(detail::kFlatMaxWidth, detail::kFlatWidthShare * std::sqrt(o.min_area));
+}
 
 constexpr double kPi = std::numbers::pi;
 constexpr int kCube = 64;  // cube-map cells per face side: ~1.4 degrees
@@ -450,7 +456,7 @@ struct Detector {
   // The rim: the stabbed sticks within rim_rings of `cluster`, flagged.
   void grow_rim(std::vector<uint32_t>& cluster, const Plane& P) {
     const size_t before = cluster.size();
-    grow(cluster, 0, o.rim_rings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
+    grow(cluster, 0, detail::kRimRings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
     for (size_t i = before; i < cluster.size(); ++i) rim[cluster[i]] = 1;
   }
 
@@ -468,7 +474,7 @@ struct Detector {
     std::vector<uint32_t> best;
     const uint32_t seed_mark = ++stamp, visited = ++stamp;
     for (uint32_t v : seeds)
-      if (near(v, P, o.tolerance)) mark[v] = seed_mark;
+      if (near(v, P, detail::kFlatTolerance)) mark[v] = seed_mark;
     for (uint32_t v : seeds) {
       if (mark[v] != seed_mark) continue;
       std::vector<uint32_t> comp{v};
@@ -489,7 +495,7 @@ struct Detector {
     std::vector<uint32_t> core = std::move(best);
     for (int round = 0; round < 12; ++round) {
       const size_t before = core.size();
-      grow(core, 0, -1, [&](uint32_t w) { return near(w, P, o.tolerance, kGrowSlack); });
+      grow(core, 0, -1, [&](uint32_t w) { return near(w, P, detail::kFlatTolerance, kGrowSlack); });
       S.positions(core, pts);
       Plane next;
       if (!constrained_fit(S, core, pts, P.n, o.margin, next)) {
@@ -515,7 +521,7 @@ struct Detector {
     // candidates, torus 0.74-0.85; pillowed box faces and the CAD part's
     // chamfer 0.93-1.0).
     bool ok = accept(core, P);
-    if (o.stab_refit && (ok || area_of(core) >= o.min_area)) {
+    if (o.passes.on(Pass::stab_refit) && (ok || area_of(core) >= o.min_area)) {
       std::vector<uint32_t> again = core;
       Plane Q = P;
       if (restab(again, Q, !ok) >= kRestabTrigger) {
@@ -524,7 +530,7 @@ struct Detector {
         ok = true;
       }
     }
-    if (ok && o.curved_gain > 0 && curved(core, P)) ok = false;
+    if (ok && o.passes.on(Pass::curved_test) && curved(core, P)) ok = false;
     if (!ok) {
       rejected = std::move(core);
       return {};
@@ -561,7 +567,7 @@ struct Detector {
     if (!Q.fit(pts, P.n)) return false;
     size_t by_quadric = 0;
     for (uint32_t v : ext) by_quadric += !std::isnan(Q.exit(S.inside(v), S.outside(v), 0.5, o.margin, 1 - o.margin));
-    return double(by_quadric) > o.curved_gain * double(stabbed_by(ext, P));
+    return double(by_quadric) > detail::kCurvedGain * double(stabbed_by(ext, P));
   }
 
   // The core and the unassigned vertices within `rings` rings of it whose
@@ -749,7 +755,7 @@ struct Detector {
     std::nth_element(spread.begin(), spread.begin() + ptrdiff_t(spread.size() / 2), spread.end());
     // At 64^3 the estimate of a box is a pillow and its smaller faces spread
     // up to 1.8 deg: they are missed (docs/BENCHMARKS.md).
-    if (spread[spread.size() / 2] > o.max_spread * kPi / 180) return false;
+    if (spread[spread.size() / 2] > detail::kFlatMaxSpread * kPi / 180) return false;
     Vec3 u, v;
     frame(P.n, u, v);
     // In-plane coordinates, centred.
@@ -770,7 +776,7 @@ struct Detector {
     }
     cov /= double(core.size());
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> pe(cov);
-    if (std::sqrt(12 * std::max(0.0, pe.eigenvalues()(0))) < o.min_width) return false;
+    if (std::sqrt(12 * std::max(0.0, pe.eigenvalues()(0))) < min_width(o)) return false;
     const Eigen::Matrix<double, 3, 2> coef = ata.ldlt().solve(atb);
     Eigen::Matrix2d B = coef.bottomRows<2>().transpose();  // rows: nu, nv; columns: d/dpu, d/dpv
     const Eigen::Matrix2d sym = 0.5 * (B + B.transpose());
@@ -784,7 +790,7 @@ struct Detector {
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
-    return kappa * (hi - lo) <= o.max_bend * kPi / 180;
+    return kappa * (hi - lo) <= detail::kFlatMaxBend * kPi / 180;
   }
 };
 
@@ -895,7 +901,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
     }
     bool again = false;
     for (size_t f = 0; f < F; ++f) {
-      if (!broken[f] && !(o.center_planes && round == 0)) continue;
+      if (!broken[f] && !(o.passes.on(Pass::center_planes) && round == 0)) continue;
       std::sort(sides[f].begin(), sides[f].end());
       sides[f].erase(std::unique(sides[f].begin(), sides[f].end()), sides[f].end());
       // Fitted: the members more than kCreaseRings rings from any other
@@ -906,12 +912,12 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       for (uint32_t v : members[f]) {
         if (depth[v] != detail::kUnreached) continue;
         inner.push_back(v);
-        if (std::abs(planes[f].n.dot(S.x[v]) - planes[f].c) <= o.tolerance) core.push_back(v);
+        if (std::abs(planes[f].n.dot(S.x[v]) - planes[f].c) <= detail::kFlatTolerance) core.push_back(v);
       }
       if (core.size() < 3) continue;
       S.positions(core, pts);
       Plane P;
-      if (!constrained_fit(S, inner, pts, planes[f].n, kSideMargin, P, sides[f], o.center_planes ? &members[f] : nullptr))
+      if (!constrained_fit(S, inner, pts, planes[f].n, kSideMargin, P, sides[f], o.passes.on(Pass::center_planes) ? &members[f] : nullptr))
         continue;
       if (detail::degrees_between(P.n, planes[f].n) > kCreaseTurn) continue;
       planes[f] = P;
@@ -996,7 +1002,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   seg.barrier.assign(n, 0);
   if (n == 0) return seg;
   const Surface S = make_surface(s, estimate);
-  const double cone = o.cone * kPi / 180, cos_cone = std::cos(cone);
+  const double cone = detail::kFlatCone * kPi / 180, cos_cone = std::cos(cone);
 
   // ---- Votes (Section 3): only vertices whose normal agrees with every
   // neighbour's within the cone (curved regions then vote little).
@@ -1114,8 +1120,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // flats whose normals are within merge_angle become one when one plane
   // stabs the sticks of both cores (the constrained fit) and, of their
   // members, at least 90 %; the rim is then grown again around them.
-  if (o.merge_angle > 0 && seg.flats.size() > 1) {
-    const double cos_merge = std::cos(o.merge_angle * kPi / 180);
+  if (o.passes.on(Pass::merge) && seg.flats.size() > 1) {
+    const double cos_merge = std::cos(detail::kMergeAngle * kPi / 180);
     detail::RingScratch rs;
     std::vector<std::vector<uint32_t>> members(seg.flats.size());
     for (size_t v = 0; v < n; ++v)
@@ -1147,7 +1153,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         core.clear();
         for (size_t f : {a, b})
           for (uint32_t v : members[f]) {
-            if (!det.near(v, planes[f], o.tolerance)) continue;
+            if (!det.near(v, planes[f], detail::kFlatTolerance)) continue;
             bool in = true;
             if (inner > 0) {
               detail::rings_around(v, inner, S.adj_off, S.adj, [](uint32_t) { return true; }, rs);
@@ -1253,7 +1259,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       for (const Vec3& p : pts) rise = std::max(rise, std::abs(F.normal.dot(p) - F.offset));
       if (rise < min_rise * cell) return false;
     }
-    if (!Q.fit(pts, outward) || Q.residual > o.tangent_residual * cell) return false;
+    if (!Q.fit(pts, outward) || Q.residual > detail::kTangentResidual * cell) return false;
     const Vec3 p = M * S.x[v];
     const Vec3 foot = p - (F.normal.dot(p) - F.offset) * F.normal;
     return std::abs(Q.normal_at(foot).dot(F.normal)) >= cos_max;
@@ -1283,11 +1289,11 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           // moved a face 0.1 cell); then all of them are used.
           Pca q;
           bool off_plane = false;  // q is the plane of the points off the flat's plane
-          if (o.junction_ring_off_plane > 0) {
+          if (o.passes.on(Pass::ring_off_plane)) {
             const Flat& F = seg.flats[size_t(f0)];
             for (const auto& [w, d] : rs.out) {
               const Vec3 p = M * S.x[w];
-              if (w == v || std::abs(F.normal.dot(p) - F.offset) > o.junction_ring_off_plane * cell) pts.push_back(p);
+              if (w == v || std::abs(F.normal.dot(p) - F.offset) > detail::kJunctionRingOffPlane * cell) pts.push_back(p);
             }
             if (pts.size() >= 3) {
               q = pca(pts);
@@ -1323,7 +1329,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             // other's crease, 0.72 voxel from any label).
             sharp = false;
             for (size_t i = 0; i < leaning_count && !sharp; ++i)
-              sharp = !(o.tangent_residual > 0 && tangent(uint32_t(v), leaning[i], cos_j, 0, rs, pts));
+              sharp = !(o.passes.on(Pass::tangent_borders) && tangent(uint32_t(v), leaning[i], cos_j, 0, rs, pts));
           }
         }
         seg.junction[v] = sharp;
@@ -1363,7 +1369,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     if (stale) detect_junctions();
     stale = false;
     // Beyond the paper: the planes also keep their creases' samples on the right side.
-    const bool refit = o.crease_refit && crease_refit(S, o, seg, planes, refitted);
+    const bool refit = o.passes.on(Pass::crease_refit) && crease_refit(S, o, seg, planes, refitted);
     if (refit) {
       for (size_t f = 0; f < planes.size(); ++f)
         if (refitted[f]) seg.flats[f] = flat_of(planes[f]);
@@ -1408,8 +1414,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // members next to the border (one ring) go back to the curved side, unless
   // a junction is within two rings (the rim is the flat's reach to that
   // crease).
-  if (o.rim_tangent_angle > 0 && !seg.flats.empty()) {
-    const double cos_t = std::cos(o.rim_tangent_angle * kPi / 180);
+  if (o.passes.on(Pass::rim_tangent) && !seg.flats.empty()) {
+    const double cos_t = std::cos(detail::kRimTangentAngle * kPi / 180);
     std::vector<uint32_t> near_junction(n, detail::kUnreached), near_tangent(n, detail::kUnreached), junctions;
     std::vector<std::pair<uint32_t, int32_t>> borders;  // a smooth border's fresh vertex and its first flat neighbour
     for (uint32_t v = 0; v < n; ++v) {
@@ -1506,7 +1512,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const auto t0 = std::chrono::steady_clock::now();
   StickSurface est = s;
   PressOptions eo = po;
-  eo.iterations = fo->estimate_iterations;  // fixed: the flats do not depend on po.iterations
+  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
   // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
   // 3, CAD part 256 seed 30 gains a 242-stick piece of a face, 3.4 degrees
   // off it, that no plane merges back).
@@ -1520,8 +1526,8 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   // piece of a face (box 64 seed 15: 1.8 degrees off) changed the second
   // estimate enough to lose that face.
   FlatOptions early = *fo;
-  early.crease_refit = false;
-  FlatSegmentation seg = find_flats(s, curves, est.t, fo->passes > 1 ? early : *fo);
+  early.passes.disable(Pass::crease_refit);
+  FlatSegmentation seg = find_flats(s, curves, est.t, detail::kDetectionPasses > 1 ? early : *fo);
   // Beyond the paper: a second pass. The estimate of a face next to rounded
   // edges is a pillow whose normals spread past the acceptance test (64^3
   // boxes, thin plates). Pressed again with the first pass's flats frozen,
@@ -1533,14 +1539,14 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
     return frozen;
   };
-  for (int pass = 1; pass < fo->passes && !seg.flats.empty(); ++pass) {
+  for (int pass = 1; pass < detail::kDetectionPasses && !seg.flats.empty(); ++pass) {
     const auto t1 = std::chrono::steady_clock::now();
     est = s;
     apply_flats(est, seg);
     press(est, curves, eo, frozen_of(seg), seg.barrier);
     t_est += seconds_since(t1);
     const FlatStats before = seg.stats;
-    seg = find_flats(s, curves, est.t, pass + 1 < fo->passes ? early : *fo);
+    seg = find_flats(s, curves, est.t, pass + 1 < detail::kDetectionPasses ? early : *fo);
     seg.stats.seconds_detect += before.seconds_detect;
     seg.stats.seconds_junctions += before.seconds_junctions;
   }
@@ -1552,20 +1558,24 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   // around them; the iterations are shared out so the cost is unchanged.
   // Each round re-presses a fifth of the iterations (fewer past 4 rounds, so
   // the first press keeps a share).
-  const bool creases = fo->crease_rounds > 0 && fo->crease_rings >= 0 && seg.stats.junctions > 0;
-  const int rest = creases ? po.iterations / std::max(5, fo->crease_rounds + 1) : 0;
+  const bool creases = fo->passes.on(Pass::crease_fit) && seg.stats.junctions > 0;
+  const int rest = creases ? po.iterations / std::max(5, detail::kCreaseRounds + 1) : 0;
   PressOptions first = po;
-  first.iterations = po.iterations - fo->crease_rounds * rest;
+  first.iterations = po.iterations - detail::kCreaseRounds * rest;
   st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
-  for (int round = 0; creases && round < fo->crease_rounds; ++round) {
+  for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
     std::vector<uint8_t> fixed;
     const auto t2 = std::chrono::steady_clock::now();
     seg.stats.crease_vertices = fit_creases(s, seg, *fo, &fixed);
+    st.passes.add(Pass::crease_fit, seconds_since(t2), round + 1 == detail::kCreaseRounds ? seg.stats.crease_vertices : 0);
+    const auto t3 = std::chrono::steady_clock::now();
     // The curved crease vertices cut the slice curves too (barriers), so
     // neither side's bilaplacian reaches across them.
     std::vector<uint8_t> barrier = seg.barrier;
     barrier.resize(s.stick_count(), 0);
     seg.stats.curved_crease_vertices = fit_curved_creases(s, seg, *fo, fixed, &barrier);
+    st.passes.add(Pass::curved_creases, seconds_since(t3),
+                  round + 1 == detail::kCreaseRounds ? seg.stats.curved_crease_vertices : 0);
     seg.stats.seconds_creases += seconds_since(t2);
     for (size_t v = 0; v < fixed.size(); ++v) fixed[v] |= seg.region[v] >= 0;
     PressOptions again = po;
@@ -1577,6 +1587,8 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     st.press.last_max_change = ps.last_max_change;
   }
   st.flats = seg.stats;
+  st.passes.add(Pass::flats, seg.stats.seconds_estimate + seg.stats.seconds_detect + seg.stats.seconds_junctions,
+                seg.flats.size());
   if (out) *out = std::move(seg);
   return st;
 }

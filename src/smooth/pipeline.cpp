@@ -85,7 +85,7 @@ uint64_t bytes_per_stick(const SurfaceOptions& o) {
   // measured with /usr/bin/time on spheres and CAD parts at 256^3 and 512^3
   // (docs/RELIABILITY.md, Resource limits), rounded up.
   if (o.method != Method::pressing) return kOtherBytesPerStick;
-  return o.flats ? kFeatureBytesPerStick : kPressBytesPerStick;
+  return o.passes.on(Pass::flats) ? kFeatureBytesPerStick : kPressBytesPerStick;
 }
 
 void validate(const SurfaceOptions& o) {
@@ -108,47 +108,11 @@ void validate(const SurfaceOptions& o) {
   in_range(o.fit.rings, 0, kMaxRings, "fit_rings");
   in_range(o.fit.residual, 0, 10, "fit_residual");
   in_range(o.fit.stab_eps, 0, 1, "fit_stab_eps");
-  const FlatOptions& f = o.flat;
-  in_range(f.min_area, 0, 1e12, "min_flat_area");
-  in_range(f.junction_angle, 0, 180, "junction_angle");
-  in_range(f.tangent_residual, 0, 10, "tangent_residual");
-  in_range(f.junction_ring_off_plane, 0, 10, "junction_ring_off_plane");
-  in_range(f.cone, 0, 90, "cone");
-  in_range(f.tolerance, 1e-6, 10, "flat_tolerance");
-  in_range(f.max_bend, 0, 180, "flat_bend");
-  in_range(f.max_spread, 0, 100, "max_spread");
-  in_range(f.min_width, 0, 1e6, "flat_width");
-  in_range(f.rim_rings, 0, kMaxRings, "rim_rings");
-  in_range(f.rim_tangent_angle, 0, 90, "rim_tangent_angle");
-  in_range(f.merge_angle, 0, 90, "merge_angle");
-  in_range(f.curved_gain, 0, 100, "curved_gain");
-  in_range(f.margin, 1e-4, 0.49, "flat margin");
-  in_range(f.estimate_iterations, 0, kMaxIterations, "estimate_iterations");
-  in_range(f.passes, 1, 8, "flat_passes");
-  in_range(f.crease_rings, 0, kMaxRings, "crease_rings");
-  in_range(f.crease_fit_rings, 0, kMaxRings, "crease_fit_rings");
-  in_range(f.crease_residual, 0, 10, "crease_residual");
-  in_range(f.crease_rounds, 0, 8, "crease_rounds");
-  const SharpenOptions& sh = o.sharp;
-  in_range(sh.sharp_angle, 0, 180, "sharp_angle");
-  in_range(sh.min_angle, 0, 180, "min_angle");
-  in_range(sh.max_move, 1e-3, 16, "max_move");
-  in_range(sh.chain_iterations, 0, 100000, "chain_iterations");
-  in_range(sh.min_curved, 0, 1e9, "min_curved");
-  in_range(sh.strip_rings, 0, kMaxRings, "strip_rings");
-  in_range(sh.curved_fit_rings, 0, kMaxRings, "curved_fit_rings");
-  in_range(sh.curved_fit_residual, 0, 10, "curved_fit_residual");
-  in_range(sh.snap_rings, 0, 2 * kMaxRings, "snap_rings");
-  in_range(sh.snap_tolerance, 0, 10, "snap_tolerance");
-  in_range(sh.snap_share, 0, 1, "snap_share");
-  in_range(sh.wall_thickness, 0, 64, "wall_thickness");
-  in_range(sh.final_crease_rings, 0, 8, "final_crease_rings");
-  in_range(sh.final_crease_fit_rings, 0, kMaxRings, "final_crease_fit_rings");
-  in_range(sh.final_crease_residual, 0, 10, "final_crease_residual");
-  in_range(sh.final_crease_max_move, 0, 10, "final_crease_max_move");
-  in_range(sh.band_reach, 0, kMaxRings, "band_reach");
-  in_range(sh.retry_right_angle, -1, 90, "retry_right_angle");
-  in_range(sh.margin, 1e-4, 0.49, "sharpen margin");
+  in_range(o.flat.min_area, 0, 1e12, "min_flat_area");
+  in_range(o.flat.junction_angle, 0, 180, "junction_angle");
+  in_range(o.flat.margin, 1e-4, 0.49, "flat margin");
+  in_range(o.sharp.sharp_angle, 0, 180, "sharp_angle");
+  in_range(o.sharp.margin, 1e-4, 0.49, "sharpen margin");
 }
 
 SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
@@ -172,24 +136,37 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   t0 = std::chrono::steady_clock::now();
   switch (o.method) {
     case Method::pressing: {
+      const PassSet& on = o.passes;
       PressOptions po = o.press;
       FlatOptions fo = o.flat;
+      fo.passes = on;
       if (o.progress) po.progress = fo.progress = o.progress;
+      po.free_ends = po.free_ends && on.on(Pass::free_ends);
       ov.apply(po);
+      const bool features = on.on(Pass::flats);
       const SliceCurves curves = build_slice_curves(surface);
-      r.press = press_with_flats(surface, curves, po, o.flats ? &fo : nullptr, &r.flats).press;
+      const FeaturePressStats fs = press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats);
+      r.press = fs.press;
+      r.pass_times = fs.passes;
       QuadricFitOptions qo = o.fit;
       qo.margin = po.margin;
+      if (!on.on(Pass::quadric_fit)) qo.rings = 0;
       r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
-      if (o.flats && o.sharpen) {
+      r.pass_times.add(Pass::quadric_fit, r.fit.seconds, r.fit.moved);
+      if (features && on.on(Pass::sharpen)) {
         SharpenOptions so = o.sharp;
         so.colors = o.color_regions;
+        so.passes = on;
         SharpenResult sr = sharpen(surface, r.flats, so);
         r.mesh = std::move(sr.mesh);
         r.sharpen = sr.stats;
+        for (size_t p = 0; p < size_t(Pass::count); ++p) {
+          r.pass_times.seconds[p] += sr.stats.passes.seconds[p];
+          r.pass_times.count[p] += sr.stats.passes.count[p];
+        }
       } else {
         r.mesh = to_mesh(surface);
-        if (o.flats) add_region_attributes(r.mesh, r.flats, o.color_regions);
+        if (features) add_region_attributes(r.mesh, r.flats, o.color_regions);
       }
       break;
     }

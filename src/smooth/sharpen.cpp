@@ -20,6 +20,7 @@
 #include "core/predicates.h"
 #include "core/sentinel.h"
 #include "crease_fit.h"
+#include "feature_tuning.h"
 #include "quadric.h"
 #include "surface_graph.h"
 
@@ -123,7 +124,7 @@ struct Sharpener {
   Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
       : s(surface), seg(f), o(opts), n(surface.stick_count()) {
     Minv_t = s.lattice.index_to_physical_matrix().inverse().transpose();
-    delta = detail::float32_clearance(s.lattice, o.max_move + 1);
+    delta = detail::float32_clearance(s.lattice, detail::kMaxMove + 1);
   }
 
   Vec3 physical_normal(const Vec3& index_normal) const { return (Minv_t * index_normal).normalized(); }
@@ -173,8 +174,8 @@ struct Sharpener {
   // tangent plane where v projects onto it; v is next to the crease, so that
   // plane's line with the flat is within ~ (0.5 cell)^2 / 2R of it.
   bool tangent_plane(uint32_t v, Plane& out) {
-    if (o.curved_fit_rings <= 0) return false;
-    detail::rings_around(v, uint32_t(o.curved_fit_rings), adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
+    if (!o.passes.on(Pass::tangent_planes)) return false;
+    detail::rings_around(v, uint32_t(detail::kCurvedFitRings), adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
     std::vector<Vec3> pts;
     Vec3 outward = Vec3::Zero();
     for (const auto& [w, d] : rings.out)
@@ -183,7 +184,7 @@ struct Sharpener {
         outward[s.axis(w)] += s.lower_inside(w) ? 1 : -1;
       }
     detail::Quadric Q;
-    if (!Q.fit(pts, outward) || Q.residual > o.curved_fit_residual) return false;
+    if (!Q.fit(pts, outward) || Q.residual > detail::kCurvedFitResidual) return false;
     const Vec3 foot = Q.foot(x[v]);
     out.n = Q.normal_at(foot);
     out.c = out.n.dot(foot);
@@ -246,7 +247,7 @@ struct Sharpener {
       return angle_deg(plane[u].n, plane[v].n) >= o.sharp_angle;
     if (a == b) return false;
     if (a >= 0 && b >= 0) {
-      return degrees_between(seg.flats[size_t(a)].normal, seg.flats[size_t(b)].normal) >= o.min_angle;
+      return degrees_between(seg.flats[size_t(a)].normal, seg.flats[size_t(b)].normal) >= detail::kMinAngle;
     }
     return junction[a < 0 ? u : v] != 0;
   }
@@ -268,7 +269,7 @@ struct Sharpener {
   // curved face (kRimStrip), not in a strip between flats: join_leftovers
   // lets it join only when the flat's plane crosses its stick.
   void thin_strips(std::vector<uint8_t>& mark) {
-    const uint32_t W = uint32_t(std::max(0, o.strip_rings));
+    const uint32_t W = uint32_t(o.passes.on(Pass::strips) ? detail::kStripRings : 0);
     if (W == 0) return;
     std::vector<uint32_t> depth(n, detail::kUnreached), front;
     for (uint32_t v = 0; v < n; ++v) {
@@ -293,7 +294,7 @@ struct Sharpener {
     // The curved vertices within W rings of one that is neither thin nor
     // marked (ring distance over curved vertices is symmetric).
     std::vector<uint32_t> near_deep(n, detail::kUnreached), deep;
-    if (o.rim_pockets) {
+    if (o.passes.on(Pass::rim_pockets)) {
       for (uint32_t v = 0; v < n; ++v)
         if (label[v] < 0 && !thin[v] && !mark[v]) {
           near_deep[v] = 0;
@@ -355,7 +356,7 @@ struct Sharpener {
       for (size_t i = 0; i < near_flats.size() && !crease; ++i)
         for (size_t j = i + 1; j < near_flats.size() && !crease; ++j)
           crease = angle_deg(seg.flats[size_t(near_flats[i])].index_normal,
-                             seg.flats[size_t(near_flats[j])].index_normal) >= o.min_angle;
+                             seg.flats[size_t(near_flats[j])].index_normal) >= detail::kMinAngle;
       if (!crease) return false;
     }
     // One flat: its half-space.
@@ -385,7 +386,7 @@ struct Sharpener {
       }
       if (convex ? at < best : at > best) best = at, flat = f, miss = miss_f;
     }
-    if (miss > o.snap_tolerance) return false;  // every plane gave a finite `at`
+    if (miss > detail::kSnapTolerance) return false;  // every plane gave a finite `at`
     s_out = std::clamp(best, o.margin, 1 - o.margin);
     return true;
   }
@@ -403,7 +404,7 @@ struct Sharpener {
   // side (Pressing's guarantee), and the creases then lie between vertices
   // on the two planes.
   void snap_to_flats() {
-    if (o.snap_rings <= 0) return;
+    if (!o.passes.on(Pass::snap)) return;
     // Candidates: curved vertices, and members up to 2 rings from a border.
     const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, 2, adj_off, adj);
     std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
@@ -414,7 +415,7 @@ struct Sharpener {
       for (uint32_t v = r.begin(); v < r.end(); ++v) {
         const bool member = seg.region[v] >= 0;
         if (member && depth[v] > 2) continue;
-        if (!solid_crossing(v, member, uint32_t(o.snap_rings), sc, flat[v], t[v]) || flat[v] == seg.region[v])
+        if (!solid_crossing(v, member, uint32_t(detail::kSnapRings), sc, flat[v], t[v]) || flat[v] == seg.region[v])
           flat[v] = -1;
       }
     });
@@ -426,16 +427,16 @@ struct Sharpener {
       // rings away: the two near flats explain most of it, the rest only
       // with the third (box 128 seeds 39 and 48). Its unexplained vertices
       // look twice as far; a curved face, mostly unexplained, is not retried.
-      if (explained >= patch.size() / 2 && double(explained) < o.snap_share * double(patch.size()))
+      if (explained >= patch.size() / 2 && double(explained) < detail::kSnapShare * double(patch.size()))
         for (uint32_t v : patch)
           if (flat[v] < 0) {
-            if (solid_crossing(v, false, 2 * uint32_t(o.snap_rings), wide, flat[v], t[v])) {
+            if (solid_crossing(v, false, 2 * uint32_t(detail::kSnapRings), wide, flat[v], t[v])) {
               ++explained;
             } else {
               flat[v] = -1;
             }
           }
-      if (double(explained) < o.snap_share * double(patch.size()))
+      if (double(explained) < detail::kSnapShare * double(patch.size()))
         for (uint32_t v : patch) flat[v] = -1;
     });
     for (uint32_t v = 0; v < n; ++v) {
@@ -459,7 +460,7 @@ struct Sharpener {
   void join_leftovers() {
     std::vector<uint8_t> small(n, 0);
     for_each_curved_patch([&](const std::vector<uint32_t>& patch) {
-      if (patch.size() < size_t(o.min_curved))
+      if (patch.size() < size_t(detail::kMinCurved))
         for (uint32_t v : patch) small[v] = kLeftover;
     });
     thin_strips(small);
@@ -529,7 +530,7 @@ struct Sharpener {
   // 1.0 voxel). A thin strip's vertex joins off the plane (join_leftovers)
   // and moves no border: at 64^3 its heirs labelled a false crease.
   void inherit_junctions() {
-    if (!o.inherit_junctions) return;
+    if (!o.passes.on(Pass::inherit_junctions)) return;
     std::vector<uint32_t> heirs;
     for (uint32_t v = 0; v < n; ++v)
       if (label[v] >= 0 && seg.region[v] < 0 && junction[v] && std::abs(height(label[v], x[v])) <= kPastSample)
@@ -603,7 +604,7 @@ struct Sharpener {
   // the solid, through the wall or the flat; left on a flat mid-rim, they
   // kinked it.
   void fit_walls() {
-    if (!(o.wall_thickness > 0)) return;
+    if (!o.passes.on(Pass::walls)) return;
     constexpr uint32_t kWallFitRings = 2;
     constexpr double kResolvedWall = 12;  // cells
     constexpr double kFlatGap = 0.1;      // cells: a fitted flat's plane may be this far off near its rim
@@ -641,7 +642,7 @@ struct Sharpener {
       }
     std::vector<uint32_t> queued(n, detail::kUnreached);
     std::vector<Near> next;
-    for (uint32_t round = 0; round < uint32_t(std::ceil(o.wall_thickness)) + 1 && !changed.empty(); ++round) {
+    for (uint32_t round = 0; round < uint32_t(std::ceil(detail::kWallThickness)) + 1 && !changed.empty(); ++round) {
       todo.clear();
       for (uint32_t v : changed)
         for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
@@ -682,7 +683,7 @@ struct Sharpener {
           // rim is crossed in about as many rings as it has cells, plus the
           // rings the flats' rims stop short of the creases).
           if (!(na.dot(fb.index_normal.normalized()) <= opposite && ha < 0.5 && hb < 0.5 &&
-                thickness <= o.wall_thickness && std::max(a[i].ring, a[j].ring) <= 1.5 * thickness + 4))
+                thickness <= detail::kWallThickness && std::max(a[i].ring, a[j].ring) <= 1.5 * thickness + 4))
             continue;
           Plane own;
           if (thickness > kResolvedWall && !(ring_plane(v, own) && std::abs(own.n.normalized().dot(na)) < kWallLean))
@@ -837,12 +838,12 @@ struct Sharpener {
   // (fixed_top.ply's faceted walls), and without the re-press that follows
   // fit_creases a long move leaves a kink.
   void final_crease_fit() {
-    if (o.final_crease_rings <= 0) return;
-    const detail::CreaseFit c{.rings = o.final_crease_rings,
-                              .fit_rings = o.final_crease_fit_rings,
-                              .residual = o.final_crease_residual,
+    if (!o.passes.on(Pass::final_crease)) return;
+    const detail::CreaseFit c{.rings = detail::kFinalCreaseRings,
+                              .fit_rings = detail::kFinalCreaseFitRings,
+                              .residual = detail::kFinalCreaseResidual,
                               .margin = o.margin,
-                              .max_move = o.final_crease_max_move};
+                              .max_move = detail::kFinalCreaseMaxMove};
     for (const auto& [v, t] : detail::crease_targets(s, seg.flats, label, junction, x, adj_off, adj, c)) {
       slide(v, t);
       ++st.final_crease_vertices;
@@ -899,7 +900,7 @@ struct Sharpener {
   // The curved neighbours of a joined vertex, and a leaving vertex, become
   // junctions.
   void past_creases() {
-    if (!o.past_crease) return;
+    if (!o.passes.on(Pass::past_crease)) return;
     struct Move {
       uint32_t v;
       int32_t label;  // the flat it joins, or -1 (it leaves its flat)
@@ -956,62 +957,6 @@ struct Sharpener {
           if (label[adj[k]] < 0) junction[adj[k]] = 1;
   }
 
-  // Beyond the paper: on-plane bands. Where the pressed estimate rounded a
-  // flat/curved crease, the flat's rim can stop a cell or two short of it,
-  // and the curved vertices left in between lie on the flat's plane (within
-  // kPastSample), which crosses their sticks; they are no junctions (their
-  // 2-ring lies mostly on the plane), so neither the flats' extension nor
-  // past_creases takes them, and the labelled chain ran along the rim, 1-2
-  // voxels inside the true crease (CAD part 128 seeds 13 and 4: 1.8 and
-  // 1.3). Such a vertex next to a member of the flat with a curved
-  // junction within band_reach rings (the border there was judged sharp;
-  // 2 rings for rims that stop two rings short, cylinder 128 seed 3's cap
-  // 2.6 -> 1.7 voxels) joins the flat, sliding
-  // along its stick onto the plane. After each round the curved neighbours
-  // of its joins that pass Section 3's test become junctions, so the
-  // chamfer edges follow the new border and the next round can go on along
-  // it (up to kBandRounds; marking them only at the end left half of seed
-  // 13's band curved, 1.4 voxels). Without a junction nearby a fillet
-  // tangent to the flat (the boss's foot: no junctions there, Flats'
-  // tangent test) took the band too, and its foot was labelled 11-21
-  // voxels from any crease on 8 of 17 rotations.
-  void join_bands() {
-    if (!o.on_plane_bands) return;
-    struct Join {
-      uint32_t v;
-      int32_t flat;
-      double t;  // where the flat's plane crosses v's stick
-    };
-    std::vector<Join> joins;
-    std::vector<uint32_t> heirs, ring;
-    for (int round = 0; round < kBandRounds; ++round) {
-      joins.clear();  // decided before any is applied: the order does not matter
-      for (uint32_t v = 0; v < n; ++v) {
-        if (label[v] >= 0 || junction[v]) continue;
-        double best;
-        const int32_t f = nearest_neighbour_flat(v, best);
-        if (f < 0 || best > kPastSample) continue;
-        const double t = flat_crossing(v, f);
-        if (!on_stick(t)) continue;
-        ring.assign(1, v);  // a curved junction within band_reach rings
-        detail::grow_rings(ring, o.band_reach, adj_off, adj);
-        bool sharp = false;
-        for (uint32_t q : ring) sharp |= label[q] < 0 && junction[q];
-        if (sharp) joins.push_back({v, f, t});
-      }
-      if (joins.empty()) break;
-      for (const Join& j : joins) {
-        slide(j.v, j.t);
-        label[j.v] = j.flat;
-      }
-      st.band_joins += joins.size();
-      heirs.clear();
-      for (const Join& j : joins) sharp_neighbours(j.v, heirs);
-      st.band_junctions += mark_junctions(heirs);
-    }
-  }
-  static constexpr int kBandRounds = 4;
-
   // Beyond the paper: creases between two curved faces (fandisk). Once the
   // labels are final, the band vertices of such creases are placed again by
   // their two sides' quadrics (detail::curved_crease_targets, as in
@@ -1023,7 +968,7 @@ struct Sharpener {
   std::vector<uint8_t> crease_side;  // per original vertex: 1 placed on a curved crease, 2 its other side's neighbour
   void curved_creases() {
     crease_side.assign(n, 0);
-    if (!o.curved_creases) return;
+    if (!o.passes.on(Pass::curved_creases)) return;
     detail::CurvedCreaseFit c;
     c.sharp_angle = o.sharp_angle;
     c.margin = o.margin;
@@ -1115,7 +1060,7 @@ struct Sharpener {
     }
     const Plane pl[2] = {A, B};
     const Vec3 moved = solve_planes(pl, 2, start, floor2);
-    if ((moved - start).norm() > o.max_move) return false;
+    if ((moved - start).norm() > detail::kMaxMove) return false;
     target = moved;
     ++st.wedge_shifts;
     return true;
@@ -1127,7 +1072,7 @@ struct Sharpener {
   // edges (the surface is unchanged until they move).
   void subdivide() {
     std::unordered_map<uint64_t, uint32_t> on_edge;
-    const double floor2 = 1 - std::cos(o.min_angle * kPi / 180);
+    const double floor2 = 1 - std::cos(detail::kMinAngle * kPi / 180);
     auto edge_vertex = [&](uint32_t a, uint32_t b) {
       auto [it, fresh] = on_edge.try_emplace(edge_key(a, b), kNone);
       if (!fresh) return it->second;
@@ -1158,8 +1103,8 @@ struct Sharpener {
         if (1 - pa->n.dot(pb->n) >= floor2) {
           v.target = solve_planes(pl, 2, start, floor2);
           const bool curved = label[v.a] < 0 && label[v.b] < 0;  // a curved/curved crease
-          v.moves = (v.target - start).norm() <= (curved ? std::min(kCurvedCreaseMove, o.max_move) : o.max_move);
-          if (v.moves && o.sample_wedges) v.moves = sample_wedge(v.a, v.b, *pa, *pb, start, floor2, v.target);
+          v.moves = (v.target - start).norm() <= (curved ? std::min(kCurvedCreaseMove, detail::kMaxMove) : detail::kMaxMove);
+          if (v.moves && o.passes.on(Pass::sample_wedges)) v.moves = sample_wedge(v.a, v.b, *pa, *pb, start, floor2, v.target);
           v.along = pa->n.cross(pb->n).normalized();
         }
       }
@@ -1213,7 +1158,7 @@ struct Sharpener {
         if (p[0] && p[1] && p[2]) {
           const Plane pl[3] = {*p[0], *p[1], *p[2]};
           c.target = solve_planes(pl, 3, start, floor2);
-          c.moves = (c.target - start).norm() <= o.max_move;
+          c.moves = (c.target - start).norm() <= detail::kMaxMove;
           if (!c.moves) c.target = start;
         }
         // Beyond the paper: where a corner's third plane is missing (a
@@ -1229,7 +1174,7 @@ struct Sharpener {
           if (1 - std::abs(p[i]->n.dot(p[j]->n)) >= floor2) {
             const Plane pl[2] = {*p[i], *p[j]};
             const Vec3 q = solve_planes(pl, 2, start, floor2);
-            if ((q - start).norm() <= o.max_move) {
+            if ((q - start).norm() <= detail::kMaxMove) {
               c.target = q;
               c.moves = true;
               c.on_flats = label[t[size_t(i)]] >= 0 && label[t[size_t(j)]] >= 0;
@@ -1441,7 +1386,7 @@ struct Sharpener {
   void smooth_chains() {
     const size_t m = nv.size();
     std::vector<Vec3> L(m), step(m);
-    for (int it = 0; it < o.chain_iterations; ++it) {
+    for (int it = 0; it < detail::kChainIterations; ++it) {
       for (uint32_t i = 0; i < m; ++i)
         L[i] = inner(i) ? Vec3((x[chain_nb[i][0]] + x[chain_nb[i][1]]) / 2 - x[n + i]) : Vec3::Zero();
       for (uint32_t i = 0; i < m; ++i) {
@@ -1476,16 +1421,21 @@ struct Sharpener {
     label = seg.region;
     junction = seg.junction;
     junction.resize(n, 0);
+    // Each step timed as its pass (the base steps as `sharpen`).
+    auto timed = [&](Pass p, auto&& step) {
+      const auto t = std::chrono::steady_clock::now();
+      step();
+      st.passes.add(p, std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
+    };
     if (!seg.flats.empty()) {
-      snap_to_flats();
-      join_leftovers();
-      inherit_junctions();
-      fit_walls();
-      final_crease_fit();
-      join_bands();
-      past_creases();
-      curved_creases();
-      subdivide();
+      timed(Pass::snap, [&] { snap_to_flats(); });
+      timed(Pass::strips, [&] { join_leftovers(); });
+      timed(Pass::inherit_junctions, [&] { inherit_junctions(); });
+      timed(Pass::walls, [&] { fit_walls(); });
+      timed(Pass::final_crease, [&] { final_crease_fit(); });
+      timed(Pass::past_crease, [&] { past_creases(); });
+      timed(Pass::curved_creases, [&] { curved_creases(); });
+      timed(Pass::sharpen, [&] { subdivide(); });
     } else {
       tris = s.triangles;
     }
@@ -1500,16 +1450,8 @@ struct Sharpener {
       // allowed; those whose target lies on flats' planes only are retried
       // (neighbours' cut-back moves may unblock them) while any vertex still
       // advances, for up to kRounds more rounds. Targets from a curved
-      // side's fit are not pushed further (on the CAD part at 256^3 that
-      // put one vertex 1.6 voxels off, 0.77 before), except on a sharp
-      // crease whose planes are within o.retry_right_angle of perpendicular:
-      // there most cut-back moves had been blocked by a fan triangle that
-      // a neighbour's later move no longer turns over (CAD part 128: 6-21
-      // sharp vertices per rotation ended 0.2-1.7 voxels short of the
-      // crease). Wider crease angles came from a leaning curved side's
-      // plane (fandisk 128: 115-125 degrees at a 90-degree crease, moved
-      // 0.8-0.9 voxel off the truth) or from a false crease on a fillet
-      // (CAD part 64: 60-85 degrees; docs/BENCHMARKS.md, Sharp edges).
+      // side's fit are not pushed further (a leaning curved side's plane
+      // would carry the vertex past the truth).
       std::vector<std::pair<uint32_t, Vec3>> jobs;
       std::vector<uint8_t> retry;
       for (uint32_t v : leftovers) {
@@ -1520,7 +1462,7 @@ struct Sharpener {
         for (size_t i = 0; i < nv.size(); ++i)
           if (nv[i].moves && nv[i].corner == bool(corners)) {
             jobs.push_back({uint32_t(n + i), nv[i].target});
-            retry.push_back(nv[i].on_flats || (nv[i].sharp && std::abs(nv[i].angle - 90) <= o.retry_right_angle));
+            retry.push_back(nv[i].on_flats);
           }
       std::vector<uint8_t> done(jobs.size(), 0);
       // Neighbours that block each other (two vertices of one thin triangle)
@@ -1542,8 +1484,21 @@ struct Sharpener {
     }
     SharpenResult r;
     r.mesh = output();
+    st.passes.count[size_t(Pass::snap)] = st.snapped;
+    st.passes.count[size_t(Pass::walls)] = st.wall_vertices;
+    st.passes.count[size_t(Pass::final_crease)] = st.final_crease_vertices;
+    st.passes.count[size_t(Pass::past_crease)] = st.past_crease + st.left_flat;
+    st.passes.count[size_t(Pass::inherit_junctions)] = st.inherited_junctions;
+    st.passes.count[size_t(Pass::curved_creases)] += st.curved_crease_vertices;
+    st.passes.count[size_t(Pass::tangent_planes)] = st.tangent_planes;
+    st.passes.count[size_t(Pass::sample_wedges)] = st.wedge_shifts;
+    st.passes.count[size_t(Pass::sharpen)] = st.inserted;
     st.sharp_edges = r.mesh.edges.size();
     st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    double others = 0;
+    for (size_t p = 0; p < size_t(Pass::count); ++p)
+      if (Pass(p) != Pass::sharpen) others += st.passes.seconds[p];
+    st.passes.seconds[size_t(Pass::sharpen)] = st.seconds - others;
     r.stats = st;
     return r;
   }

@@ -550,21 +550,33 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   EXPECT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method taubin --fixed-ends", &out),
             2);
   EXPECT_NE(out.find("--fixed-ends applies to --method pressing only"), std::string::npos) << out;
-  // --no-curved-creases: a box has no crease between two curved faces, so
-  // the counts are 0 and the surface does not change.
+  // --disable-pass curved-creases: a box has no crease between two curved
+  // faces, so the counts are 0 and the surface does not change; the pass
+  // table says it was off.
   EXPECT_EQ(st["flats"]["curved_crease_vertices"].get<size_t>(), 0u);
   EXPECT_EQ(st["sharpen"]["curved_crease_vertices"].get<size_t>(), 0u);
   ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("nc.ply") +
-                        " --check --color-regions --no-curved-creases",
+                        " --check --color-regions --disable-pass curved-creases --stats-json " + tmp.path("nc.json"),
                     &out),
             0)
       << out;
   EXPECT_EQ(test::read_file(tmp.path("nc.ply")), test::read_file(tmp.path("b.ply")));
+  bool listed = false;
+  const nlohmann::json nc = nlohmann::json::parse(std::ifstream(tmp.path("nc.json")));
+  for (const auto& p : nc["passes"])
+    if (p["name"] == "curved-creases") {
+      listed = true;
+      EXPECT_FALSE(p["enabled"].get<bool>());
+    }
+  EXPECT_TRUE(listed);
   EXPECT_EQ(
-      run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method cesn --no-curved-creases",
+      run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method cesn --disable-pass snap",
               &out),
       2);
-  EXPECT_NE(out.find("--no-curved-creases applies to --method pressing only"), std::string::npos) << out;
+  EXPECT_NE(out.find("--disable-pass applies to --method pressing only"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --disable-pass snapp", &out), 2);
+  EXPECT_NE(out.find("unknown pass 'snapp'"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
   // --no-sharpen: the chamfered surface, vertex regions only; --features then is a usage error.
   ASSERT_EQ(run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("c.ply") + " --no-sharpen", &out), 0) << out;
   const Mesh chamfered = read_mesh(tmp.path("c.ply"));

@@ -140,7 +140,7 @@ def test_truncated_tiff_is_an_error_naming_the_file(tmp_path):
             voxpress.read_volume(str(cut_path))
 
 
-def test_wall_thickness_reaches_the_sharpening():
+def test_disable_passes_reaches_the_sharpening():
     # A tilted plate 3 cells thick: its rim lies between two opposite flats.
     i, j, k = np.indices((56, 56, 56)).astype(float) - 27.6
     n = np.array([0.25, 0.15, 1.0]) / np.linalg.norm([0.25, 0.15, 1.0])
@@ -151,11 +151,13 @@ def test_wall_thickness_reaches_the_sharpening():
     a = u[0] * i + u[1] * j + u[2] * k
     b = w[0] * i + w[1] * j + w[2] * k
     plate = (np.abs(h) < 1.5) & (np.abs(a) < 20) & (np.abs(b) < 14)
-    walls, flat = voxpress.press(plate), voxpress.press(plate, wall_thickness=0)
+    walls, flat = voxpress.press(plate), voxpress.press(plate, disable_passes=["walls"])
     assert walls.stats["flats"] >= 2
     assert not np.array_equal(walls.vertices[: len(flat.vertices)], flat.vertices)
     for mesh in (walls, flat):
         assert voxpress.check(mesh, plate)["classification_violations"] == 0
+    with pytest.raises(voxpress.UsageError, match="unknown pass 'wall'"):
+        voxpress.press(plate, disable_passes=["wall"])
 
 
 def test_mesh_outputs_and_evaluation(tmp_path):
@@ -201,7 +203,7 @@ def test_no_memory_growth_over_1000_calls():
 def test_press_shows_its_real_signature_and_docstring():
     import inspect
     params = inspect.signature(voxpress.press).parameters
-    for name in ("spacing", "method", "iterations", "junction_angle", "sharp_angle", "wall_thickness", "lambda_"):
+    for name in ("spacing", "method", "iterations", "junction_angle", "sharp_angle", "disable_passes", "lambda_"):
         assert name in params
     assert not any(p.kind == p.VAR_KEYWORD for p in params.values())
     assert "sharp_angle" in voxpress.press.__doc__

@@ -42,7 +42,7 @@ TEST(Pipeline, PressingStagesAndOverridesAreHonoured) {
   const SurfaceResult full = smooth_surface(box.volume, o);
   EXPECT_GT(full.flats.flats.size(), 0u);
   EXPECT_GT(full.mesh.edges.size(), 0u);  // sharp edges inserted
-  o.sharpen = false;
+  o.passes.disable(Pass::sharpen);
   const SurfaceResult chamfered = smooth_surface(box.volume, o);
   EXPECT_TRUE(chamfered.mesh.edges.empty());
   EXPECT_EQ(chamfered.mesh.vertex_count(), chamfered.extract.sticks);
@@ -53,7 +53,7 @@ TEST(Pipeline, PressingStagesAndOverridesAreHonoured) {
   EXPECT_LE(chamfered.fit.fitted, chamfered.extract.sticks - chamfered.flats.frozen_count());
   o.fit.rings = 0;
   EXPECT_EQ(smooth_surface(box.volume, o).fit.fitted, 0u);
-  o.flats = false;
+  o.passes.disable(Pass::flats);
   o.overrides.iterations = 3;
   const SurfaceResult plain = smooth_surface(box.volume, o);
   EXPECT_TRUE(plain.flats.flats.empty());
@@ -119,6 +119,42 @@ TEST(Pipeline, SameMeshForOneAndManyThreadsOnThePropertyVolumes) {
     }
   }
   EXPECT_GT(compared, 50);
+}
+
+TEST(Passes, TableIsInRunningOrderAndNamesRoundTrip) {
+  const auto& passes = feature_passes();
+  ASSERT_EQ(passes.size(), size_t(Pass::count));
+  for (size_t i = 0; i < passes.size(); ++i) {
+    EXPECT_EQ(size_t(passes[i].pass), i) << passes[i].name;
+    EXPECT_EQ(parse_pass(passes[i].name), passes[i].pass);
+    EXPECT_STRNE(passes[i].section, "");
+  }
+  EXPECT_THROW(parse_pass("no-such-pass"), UsageError);
+  PassSet s;
+  s.disable("walls");
+  s.disable(Pass::flats);
+  EXPECT_FALSE(s.on(Pass::walls));
+  EXPECT_TRUE(s.on(Pass::snap));
+  EXPECT_EQ(s.disabled(), (std::vector<std::string>{"flats", "walls"}));
+}
+
+TEST(Passes, EachPassOffKeepsTheGuarantees) {
+  // Every pass switched off alone on a rotated CAD part (flats, fillets,
+  // creases): the result still keeps every sample on its side and is a
+  // closed, oriented 2-manifold; the pass's own count drops to 0.
+  GenerateOptions g;
+  g.res = 40;
+  g.rotation = parse_rotation("random:3");
+  const GeneratedShape part = generate_shape(ShapeKind::cad_part, g);
+  for (const PassInfo& p : feature_passes()) {
+    SCOPED_TRACE(p.name);
+    SurfaceOptions o;
+    o.passes.disable(p.pass);
+    const SurfaceResult r = smooth_surface(part.volume, o);
+    EXPECT_EQ(r.pass_times.count[size_t(p.pass)], 0u);
+    EXPECT_TRUE(check_mesh(r.mesh).ok());
+    EXPECT_EQ(check_classification(r.mesh, part.volume).violations, 0u);
+  }
 }
 
 }  // namespace

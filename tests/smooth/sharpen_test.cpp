@@ -248,7 +248,6 @@ TEST(Sharpen, SubdivisionFollowsFigure8) {
 TEST(Sharpen, PropertyCorpusKeepsEveryGuarantee) {
   FlatOptions fo;
   fo.min_area = 4;  // small volumes: let flats, junctions and chamfers happen
-  fo.min_width = 1;
   PressOptions po;
   po.iterations = 30;
   size_t sharpened = 0;
@@ -343,7 +342,7 @@ TEST(Sharpen, ThinPlatesGetBothEdgesOfTheirRim) {
   // walls one crease runs along the middle of the rim, a cell or more from
   // both true edges (fit_walls). The truth is the plate's mesh.
   SharpenOptions no_walls;
-  no_walls.wall_thickness = 0;
+  no_walls.passes.disable(Pass::walls);
   for (double cells : {2.5, 4.0})
     for (int seed : {1, 2, 3}) {
       SCOPED_TRACE("thickness " + std::to_string(cells) + " seed " + std::to_string(seed));

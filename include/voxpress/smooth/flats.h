@@ -82,77 +82,16 @@
 #include "voxpress/core/mesh.h"
 #include "voxpress/core/progress.h"
 #include "voxpress/extract/sticks.h"
+#include "voxpress/features/passes.h"
 #include "voxpress/smooth/pressing.h"
 
 namespace voxpress {
 
 struct FlatOptions {
   double min_area = 100;       ///< smallest flat, in cell areas (index space)
-  double junction_angle = 30;  ///< degrees (paper: 30)
-  /// Beyond the paper: a would-be junction whose curved side (2-6 rings
-  /// away) fits a quadric within this RMS (cells), with the quadric's normal
-  /// within junction_angle of the flat's where the vertex projects onto the
-  /// flat, is a tangent (smooth) border, e.g. a fillet (0: off).
-  double tangent_residual = 0.1;
-  /// Beyond the paper: the junction test's 2-ring plane leaves out the
-  /// fresh vertices within this many cells of the flat's plane (a rim
-  /// stopped short; the vertex itself stays in, and all are used when the
-  /// rest are fewer than 3 or a thin row). 0: the paper's plane.
-  double junction_ring_off_plane = 0.1;
-  double cone = 3;             ///< degrees: a vertex votes for directions within this of its normal
-  double tolerance = 0.3;      ///< cells: core vertices lie this close to the plane (estimate)
-  double max_bend = 5;         ///< degrees: largest normal change across a flat's core (linear fit)
-  double max_spread = 1.4;     ///< degrees: largest median angle between a core normal and the plane's
-  double min_width = 3;        ///< cells: sqrt(12) x the in-plane minor standard deviation
-  int rim_rings = 2;           ///< surface rings added around the core
-  /// Beyond the paper: at a smooth border whose curved side continues the
-  /// flat within this many degrees (the tangent test's quadric, 2-6 rings
-  /// away), the rim's members next to the border are given back to the
-  /// curved side unless a junction is within 2 rings: the rim ran onto a
-  /// fillet there, not up to a crease (0: off).
-  double rim_tangent_angle = 15;
-  double merge_angle = 4;      ///< degrees: adjacent flats this close are merged when one plane stabs both (0: off)
-  /// Beyond the paper: refit each core's plane by the count of sticks it
-  /// stabs around it, not by the estimate (faces near a lattice axis, whose
-  /// estimate is a pillow); also rescues cores the spread and bend tests
-  /// refused when that plane stabs 90 % of their neighbourhood.
-  bool stab_refit = true;
-  /// Beyond the paper: a flat is refused when a quadric fitted to its
-  /// neighbourhood (10 rings, normals within 30 degrees) stabs more than
-  /// this many times as many of those sticks as its plane: a tangent strip
-  /// of a curved face, which the spread and bend tests pass when the face
-  /// is gently curved or a previous pass froze the strip (0: off).
-  double curved_gain = 1.3;
-  /// Beyond the paper: refit the planes so that they also keep the samples
-  /// of their sharp creases on the right side (faces nearly containing a
-  /// lattice axis, whose own sticks leave their tilt loose).
-  bool crease_refit = true;
-  /// Beyond the paper, with crease_refit: every final plane is refitted
-  /// once and moved from the least-squares plane to the centre of its
-  /// feasible set (its members and its creases' samples). The estimate the
-  /// least squares fit is itself smoothed and biased along the directions
-  /// the sticks leave loose (a face near a lattice plane); the centre is the
-  /// unbiased guess there and changes little elsewhere.
-  bool center_planes = true;
+  double junction_angle = 30;  ///< degrees between a flat and its curved neighbour above which their border is sharp (paper: 30)
   double margin = 0.01;        ///< frozen t kept in [margin, 1 - margin]
-  int estimate_iterations = 100;  ///< Pressing iterations of the estimate (the other press options are shared)
-  /// Detection passes. Pass k > 1 re-estimates with pass k-1's flats frozen
-  /// (their edges sharp, not rounded) and detects again from scratch.
-  int passes = 2;
-  /// Beyond the paper, fit_creases: fresh vertices up to `crease_rings`
-  /// rings from a junction are placed by a quadric fitted to the fresh
-  /// vertices of the next `crease_fit_rings` rings, when its RMS residual is
-  /// at most `crease_residual` cells; `crease_rounds` times (0: off).
-  int crease_rings = 2;
-  int crease_fit_rings = 5;
-  double crease_residual = 0.04;
-  int crease_rounds = 4;
-  /// Beyond the paper, fit_curved_creases: in the same rounds, the curved
-  /// vertices of creases between two curved faces (a narrow band where the
-  /// normals turn fast, whose two sides meet at `junction_angle` or more)
-  /// are placed where their sticks leave the two sides' quadrics, fitted a
-  /// few rings away.
-  bool curved_creases = true;
+  PassSet passes;              ///< the layer's passes (voxpress/features/passes.h)
   Progress* progress = nullptr;
 };
 
@@ -217,6 +156,7 @@ size_t fit_curved_creases(StickSurface& surface, const FlatSegmentation& flats, 
 struct FeaturePressStats {
   PressStats press;
   FlatStats flats;
+  PassTimes passes;  ///< flats, crease_fit and curved_creases (press time), with their counts
 };
 
 /// The whole Pressing pipeline: estimate (press a copy), find flats and

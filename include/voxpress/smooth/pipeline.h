@@ -21,6 +21,7 @@
 #include "voxpress/core/progress.h"
 #include "voxpress/core/volume.h"
 #include "voxpress/extract/sticks.h"
+#include "voxpress/features/passes.h"
 #include "voxpress/smooth/flats.h"
 #include "voxpress/smooth/mesh_smoothing.h"
 #include "voxpress/smooth/pressing.h"
@@ -53,11 +54,12 @@ struct SurfaceOptions {
   Method method = Method::pressing;
   // --- pressing
   PressOptions press;
-  bool flats = true;         ///< find flats and junctions (Section 3)
-  FlatOptions flat;
-  QuadricFitOptions fit;     ///< the local quadric fit after pressing (fit.rings = 0: none); margin from press
-  bool sharpen = true;       ///< insert the sharp edges (Section 5; needs flats)
-  SharpenOptions sharp;
+  FlatOptions flat;          ///< flats and junctions (Section 3); flat.passes and sharp.passes are set from `passes`
+  QuadricFitOptions fit;     ///< the local quadric fit after pressing; margin from press
+  SharpenOptions sharp;      ///< sharp edges (Section 5)
+  /// The feature layer's passes (voxpress/features/passes.h): disable
+  /// Pass::flats for plain Pressing, Pass::sharpen to keep the chamfers.
+  PassSet passes;
   bool color_regions = false;  ///< vertex colours per region
   // --- every method: when set, the iteration cap and the stopping tolerance
   // (pressing: over press.iterations / press.tolerance); lambda and mu for
@@ -79,6 +81,7 @@ struct SurfaceResult {
   // the other methods
   SmoothStats smooth;          ///< diamond, cell-edge, cell-size, taubin, laplacian
   SurfaceNetStats net;         ///< cesn
+  PassTimes pass_times;         ///< pressing: seconds and counts per pass
   double seconds_extract = 0, seconds_smooth = 0;
 };
 

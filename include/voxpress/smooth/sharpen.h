@@ -66,83 +66,9 @@ namespace voxpress {
 
 struct SharpenOptions {
   double sharp_angle = 30;    ///< degrees between the two sides' normals above which a crease is labelled sharp
-  double min_angle = 10;      ///< degrees: planes meeting at less are not intersected
-  double max_move = 2;        ///< cells: farthest a new vertex may move from where it was inserted
-  int chain_iterations = 10;  ///< bilaplacian iterations along the feature chains (0: none)
-  int min_curved = 25;        ///< vertices: smaller curved patches are chamfer leftovers and join a flat
-  /// Beyond the paper: curved vertices at most this many rings from a flat,
-  /// whose curved neighbours within as many rings are too, form a thin strip
-  /// and join a flat (0: off).
-  int strip_rings = 2;
-  /// Beyond the paper: a thin vertex in a pocket of a flat's rim next to a
-  /// real curved face joins the flat only when the flat's plane crosses its
-  /// stick, and then slides onto it; otherwise it stays curved, past the
-  /// crease (false: it joins like a strip vertex). See join_leftovers.
-  bool rim_pockets = true;
-  /// Beyond the paper: a curved side's plane is the tangent plane of the
-  /// quadric fitted to its fresh vertices within this many rings, when the
-  /// fit's RMS residual is at most `curved_fit_residual` cells (0: the
-  /// paper's least-squares plane of the 2-ring).
-  int curved_fit_rings = 6;
-  double curved_fit_residual = 0.05;
-  /// Beyond the paper: curved patches that the solid of the flats around
-  /// them explains (its crossing of each stick, searched over the flats
-  /// within `snap_rings` rings, misses by at most `snap_tolerance` cells for
-  /// a share `snap_share` of the patch's sticks) are bands the flats' rims
-  /// stopped short of: their vertices slide along their sticks onto the
-  /// flats (0: off). See snap_to_flats in sharpen.cpp.
-  int snap_rings = 8;
-  double snap_tolerance = 0.05;
-  double snap_share = 0.95;
-  /// Beyond the paper: the rim of a plate at most this many cells thick (a
-  /// wall between two nearly opposite flats) gets its own plane, the widest
-  /// separator of its sticks' samples, so both its edges are sharpened (0:
-  /// off). See fit_walls in sharpen.cpp.
-  double wall_thickness = 24;
-  /// Beyond the paper: once the labels are final, the curved vertices up to
-  /// this many rings from a junction are placed again by the crease fit of
-  /// press_with_flats (the flat's plane and the curved side's quadric over
-  /// the next `final_crease_fit_rings` rings, trusted up to
-  /// `final_crease_residual` cells RMS), each moving at most
-  /// `final_crease_max_move` cells along its stick (0: off). See
-  /// final_crease_fit in sharpen.cpp.
-  int final_crease_rings = 2;
-  int final_crease_fit_rings = 5;
-  double final_crease_residual = 0.04;
-  double final_crease_max_move = 0.3;
-  /// Beyond the paper: creases between two curved faces are placed by their
-  /// sides' quadrics and sharpened like flat borders (curved_creases in
-  /// sharpen.cpp; press_with_flats does the placing too, FlatOptions).
-  bool curved_creases = true;
-  /// Beyond the paper: vertices on the wrong side of a flat/curved crease
-  /// change sides, judged by the local solid of the flat's plane and the
-  /// curved side's quadric tangent plane: a curved junction vertex past it
-  /// joins the flat, a flat member past it leaves the flat (past_creases in
-  /// sharpen.cpp).
-  bool past_crease = true;
-  /// Beyond the paper: the curved neighbours of a curved junction that
-  /// joined a flat (snap_to_flats, join_leftovers) become junctions, so the
-  /// border keeps its chamfer edges there (inherit_junctions in sharpen.cpp).
-  bool inherit_junctions = true;
-  /// Beyond the paper: curved, non-junction vertices between a flat's rim
-  /// and a sharp border that lie on the flat's plane join the flat, and
-  /// their curved neighbours past Section 3's test become junctions
-  /// (join_bands in sharpen.cpp).
-  bool on_plane_bands = true;
-  int band_reach = 2;  ///< rings: a band vertex needs a curved junction this close (1: a neighbour)
-  /// Beyond the paper: a flat/curved chamfer edge's two planes must agree with the
-  /// samples of its sticks (no outside sample inside both at a convex
-  /// crease, no inside sample outside both at a concave one); where they do
-  /// not, the curved side's plane moves onto the sample, or the new vertex
-  /// stays where it was inserted (sample_wedge in sharpen.cpp).
-  bool sample_wedges = true;
-  /// Beyond the paper: a new vertex's move onto a sharp crease whose two
-  /// planes meet within this many degrees of perpendicular keeps being
-  /// retried after the moves are cut back, like those onto flats' planes
-  /// only (run() in sharpen.cpp; negative: off).
-  double retry_right_angle = 10;
   double margin = 0.01;       ///< snapped vertices keep t in [margin, 1 - margin] on their sticks
   bool colors = false;        ///< vertex colours per region (flats, curved grey, junctions orange, features red)
+  PassSet passes;             ///< the layer's passes (voxpress/features/passes.h)
   Progress* progress = nullptr;
 };
 
@@ -158,12 +84,11 @@ struct SharpenStats {
   size_t past_crease = 0;             ///< curved junction vertices past their crease that joined the flat
   size_t left_flat = 0;               ///< flat members past their crease that left the flat (past_creases)
   size_t inherited_junctions = 0;     ///< curved vertices made junctions by a joined neighbour (inherit_junctions)
-  size_t band_joins = 0;              ///< on-plane band vertices that joined a flat (join_bands)
-  size_t band_junctions = 0;          ///< curved vertices made junctions by a joined band vertex (join_bands)
   size_t wedge_checks = 0;            ///< chamfer edges whose two planes' solid misplaced a sample (sample_wedge)
   size_t wedge_shifts = 0;            ///< ... of which the curved side's plane was moved onto the sample
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
+  PassTimes passes;                   ///< per pass (the base steps as Pass::sharpen)
   double seconds = 0;
 };
 
