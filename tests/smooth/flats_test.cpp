@@ -14,7 +14,7 @@
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
 #include "voxpress/eval/voxelize.h"
-#include "voxpress/smooth/flats.h"
+#include "voxpress/features/flats.h"
 #include "voxpress/smooth/pipeline.h"
 
 namespace voxpress {

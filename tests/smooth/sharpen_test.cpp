@@ -15,7 +15,7 @@
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
 #include "voxpress/eval/voxelize.h"
-#include "voxpress/smooth/sharpen.h"
+#include "voxpress/features/sharpen.h"
 
 namespace voxpress {
 namespace {

@@ -22,10 +22,10 @@
 #include "voxpress/core/volume.h"
 #include "voxpress/extract/sticks.h"
 #include "voxpress/features/passes.h"
-#include "voxpress/smooth/flats.h"
+#include "voxpress/features/flats.h"
 #include "voxpress/smooth/mesh_smoothing.h"
 #include "voxpress/smooth/pressing.h"
-#include "voxpress/smooth/sharpen.h"
+#include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
 
 namespace voxpress {

@@ -1,6 +1,6 @@
 // Beyond the paper: the fresh vertices next to a sharp flat border placed by
 // the curved side's own surface, extrapolated up to the flat. Theory of
-// operation: include/voxpress/smooth/flats.h (fit_creases).
+// operation: include/voxpress/features/flats.h (fit_creases).
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -11,9 +11,9 @@
 
 #include "crease_fit.h"
 #include "feature_tuning.h"
-#include "quadric.h"
-#include "surface_graph.h"
-#include "voxpress/smooth/flats.h"
+#include "smooth/quadric.h"
+#include "smooth/surface_graph.h"
+#include "voxpress/features/flats.h"
 
 namespace voxpress {
 

@@ -1,4 +1,4 @@
-// voxpress/smooth/sharpen.h — sharp edge recovery (Pressing, Chica et al.,
+// voxpress/features/sharpen.h — sharp edge recovery (Pressing, Chica et al.,
 // Section 5) and the flat / curved / sharp segmentation as output.
 //
 // The pressed stick surface cuts every feature with a chamfer one cell wide:
@@ -60,7 +60,7 @@
 #include "voxpress/core/mesh.h"
 #include "voxpress/core/progress.h"
 #include "voxpress/extract/sticks.h"
-#include "voxpress/smooth/flats.h"
+#include "voxpress/features/flats.h"
 
 namespace voxpress {
 

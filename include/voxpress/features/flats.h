@@ -1,4 +1,4 @@
-// voxpress/smooth/flats.h — flats by plane voting (max tiles) and junction
+// voxpress/features/flats.h — flats by plane voting (max tiles) and junction
 // points (Pressing, Chica et al., Section 3), and the Pressing pipeline that
 // uses them (Section 4, last paragraph).
 //

@@ -7,10 +7,10 @@
 #include <utility>
 #include <vector>
 
-#include "surface_graph.h"
+#include "smooth/surface_graph.h"
 #include "voxpress/core/types.h"
 #include "voxpress/extract/sticks.h"
-#include "voxpress/smooth/flats.h"
+#include "voxpress/features/flats.h"
 
 namespace voxpress::detail {
 

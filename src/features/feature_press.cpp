@@ -1,0 +1,155 @@
+// The Pressing pipeline with flats (Section 4, last paragraph): estimate,
+// detect, freeze, press, crease rounds; and the region outputs. Theory of
+// operation: include/voxpress/features/flats.h.
+#include "core/timing.h"
+#include "feature_tuning.h"
+#include "voxpress/features/flats.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace voxpress {
+
+using detail::seconds_since;
+
+void apply_flats(StickSurface& s, const FlatSegmentation& f) {
+  for (size_t v = 0; v < s.stick_count(); ++v) {
+    if (f.region[v] < 0) {
+      s.t[v] = 0.5;
+      continue;
+    }
+    // seg.t is measured from the inside sample; StickSurface::t from the lower one.
+    s.t[v] = s.lower_inside(v) ? f.t[v] : 1 - f.t[v];
+  }
+}
+
+FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
+                                   const FlatOptions* fo, FlatSegmentation* out) {
+  FeaturePressStats st;
+  if (!fo) {
+    st.press = press(s, curves, po);
+    if (out) {
+      *out = FlatSegmentation{};
+      out->region.assign(s.stick_count(), -1);
+    }
+    return st;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  StickSurface est = s;
+  PressOptions eo = po;
+  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
+  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
+  // 3, CAD part 256 seed 30 gains a 242-stick piece of a face, 3.4 degrees
+  // off it, that no plane merges back).
+  eo.levels = 2;
+  eo.tolerance = 0;
+  eo.progress = nullptr;
+  eo.free_ends = false;  // see PressOptions::free_ends
+  press(est, curves, eo);
+  double t_est = seconds_since(t0);
+  // The crease refit serves the final planes only: refitting a first pass's
+  // piece of a face (box 64 seed 15: 1.8 degrees off) changed the second
+  // estimate enough to lose that face.
+  FlatOptions early = *fo;
+  early.passes.disable(Pass::crease_refit);
+  FlatSegmentation seg = find_flats(s, curves, est.t, detail::kDetectionPasses > 1 ? early : *fo);
+  // Beyond the paper: a second pass. The estimate of a face next to rounded
+  // edges is a pillow whose normals spread past the acceptance test (64^3
+  // boxes, thin plates). Pressed again with the first pass's flats frozen,
+  // their edges are sharp and the faces between them flat, so the second
+  // detection (from scratch, on the new estimate) finds the faces the
+  // first missed. Box 64, seeds 1-30: 162 -> 177 of 180 faces.
+  auto frozen_of = [](const FlatSegmentation& f) {
+    std::vector<uint8_t> frozen(f.region.size());
+    for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
+    return frozen;
+  };
+  for (int pass = 1; pass < detail::kDetectionPasses && !seg.flats.empty(); ++pass) {
+    const auto t1 = std::chrono::steady_clock::now();
+    est = s;
+    apply_flats(est, seg);
+    press(est, curves, eo, frozen_of(seg), seg.barrier);
+    t_est += seconds_since(t1);
+    const FlatStats before = seg.stats;
+    seg = find_flats(s, curves, est.t, pass + 1 < detail::kDetectionPasses ? early : *fo);
+    seg.stats.seconds_detect += before.seconds_detect;
+    seg.stats.seconds_junctions += before.seconds_junctions;
+  }
+  seg.stats.seconds_estimate = t_est;
+  apply_flats(s, seg);
+  // Beyond the paper: the vertices near sharp flat/curved borders placed
+  // by the curved side's fit (fit_creases), and those of creases between
+  // two curved faces by both sides' fits (fit_curved_creases), then the rest pressed again
+  // around them; the iterations are shared out so the cost is unchanged.
+  // Each round re-presses a fifth of the iterations (fewer past 4 rounds, so
+  // the first press keeps a share).
+  const bool creases = fo->passes.on(Pass::crease_fit) && seg.stats.junctions > 0;
+  const int rest = creases ? po.iterations / std::max(5, detail::kCreaseRounds + 1) : 0;
+  PressOptions first = po;
+  first.iterations = po.iterations - detail::kCreaseRounds * rest;
+  st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
+  for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
+    std::vector<uint8_t> fixed;
+    const auto t2 = std::chrono::steady_clock::now();
+    seg.stats.crease_vertices = fit_creases(s, seg, *fo, &fixed);
+    st.passes.add(Pass::crease_fit, seconds_since(t2), round + 1 == detail::kCreaseRounds ? seg.stats.crease_vertices : 0);
+    const auto t3 = std::chrono::steady_clock::now();
+    // The curved crease vertices cut the slice curves too (barriers), so
+    // neither side's bilaplacian reaches across them.
+    std::vector<uint8_t> barrier = seg.barrier;
+    barrier.resize(s.stick_count(), 0);
+    seg.stats.curved_crease_vertices = fit_curved_creases(s, seg, *fo, fixed, &barrier);
+    st.passes.add(Pass::curved_creases, seconds_since(t3),
+                  round + 1 == detail::kCreaseRounds ? seg.stats.curved_crease_vertices : 0);
+    seg.stats.seconds_creases += seconds_since(t2);
+    for (size_t v = 0; v < fixed.size(); ++v) fixed[v] |= seg.region[v] >= 0;
+    PressOptions again = po;
+    again.iterations = rest;
+    again.levels = 1;  // the fine stage goes on
+    const PressStats ps = press(s, curves, again, fixed, barrier);
+    st.press.iterations += ps.iterations;
+    st.press.seconds += ps.seconds;
+    st.press.last_max_change = ps.last_max_change;
+  }
+  st.flats = seg.stats;
+  st.passes.add(Pass::flats, seg.stats.seconds_estimate + seg.stats.seconds_detect + seg.stats.seconds_junctions,
+                seg.flats.size());
+  if (out) *out = std::move(seg);
+  return st;
+}
+
+void add_region_attributes(Mesh& mesh, const FlatSegmentation& f, bool colors) {
+  const size_t n = mesh.vertex_count();
+  if (f.region.size() != n) throw std::invalid_argument("add_region_attributes: segmentation does not match the mesh");
+  MeshAttribute region{"region", ScalarType::i32, std::vector<double>(n)};
+  MeshAttribute junction{"junction", ScalarType::u8, std::vector<double>(n)};
+  for (size_t v = 0; v < n; ++v) {
+    region.values[v] = f.region[v];
+    junction.values[v] = f.junction.empty() ? 0 : f.junction[v];
+  }
+  mesh.vertex_attributes.push_back(std::move(region));
+  mesh.vertex_attributes.push_back(std::move(junction));
+  if (!colors) return;
+  mesh.colors.resize(n);
+  for (size_t v = 0; v < n; ++v) mesh.colors[v] = region_color(f.region[v], !f.junction.empty() && f.junction[v]);
+}
+
+std::array<uint8_t, 4> region_color(int32_t region, bool junction) {
+  if (junction) return {255, 140, 0, 255};
+  if (region < 0) return {170, 170, 170, 255};
+  // Golden-angle hues: neighbouring ids get distant colours.
+  const double h = std::fmod(double(region) * 137.50776, 360.0) / 60.0;
+  const double x = 1 - std::abs(std::fmod(h, 2.0) - 1);
+  double rgb[3] = {0, 0, 0};
+  const int sector = int(h);
+  const int order[6][2] = {{0, 1}, {1, 0}, {1, 2}, {2, 1}, {2, 0}, {0, 2}};  // HSV sectors: (full, rising)
+  rgb[order[sector][0]] = 1;
+  rgb[order[sector][1]] = x;
+  for (double& c : rgb) c = 0.25 + 0.65 * c;
+  return {uint8_t(255 * rgb[0]), uint8_t(255 * rgb[1]), uint8_t(255 * rgb[2]), 255};
+}
+
+
+}  // namespace voxpress

@@ -1,0 +1,231 @@
+// Private to the flats (Section 3): the detector's constants, its view of
+// the estimated surface, the direction cells of the vote and the plane fits
+// (least squares inside the set of planes that stab a cluster). Index space
+// throughout. Theory of operation: include/voxpress/features/flats.h.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "feature_tuning.h"
+#include "smooth/surface_graph.h"
+#include "voxpress/features/flats.h"
+
+namespace voxpress::flats_impl {
+
+// The narrowest flat: a share of the smallest flat's side, capped (cells).
+inline double min_width(const FlatOptions& o) {
+  return std::min(detail::kFlatMaxWidth, detail::kFlatWidthShare * std::sqrt(o.min_area));
+}
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kCube = 64;  // cube-map cells per face side: ~1.4 degrees
+constexpr int kNormalRings = 3;  // smoothing rounds of the estimated normals
+// The growth also takes a stick the current plane misses by up to this
+// fraction of it (the refit must then stab it, or it leaves): the sticks a
+// plane a hair off misses come in lattice rows that would cut a face in
+// bands. Box 64, seeds 1-30: 28 -> 29 with six flats, stick error 0.074 ->
+// 0.065; 0.1 and 0.2 found fewer faces on the CAD part at 64^3.
+constexpr double kGrowSlack = 0.05;
+constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
+// An accumulator cell seeds a cluster when it has at least this share of
+// min_area voters; the flat itself must still reach min_area after growth
+// (accept). Voters are the vertices whose estimated normal lies within the
+// cone of the cell's direction, so a face whose estimate its rounded edges
+// bend has far fewer voters than sticks: fandisk 128's two 600-cell side
+// faces had 46 in their best cell and were never tried with a share of 1
+// (docs/ARCHITECTURE.md, Flats: Greedy extraction).
+constexpr double kSeedShare = 0.3;
+// The curvature test (Detector::curved, FlatOptions::curved_gain): a flat's
+// neighbourhood is its core grown kCurvedRings rings over the vertices whose
+// normal is within kCurvedWindow degrees of the plane's.
+constexpr int kCurvedRings = 10;
+constexpr double kCurvedWindow = 30;
+constexpr uint32_t kTangentRings[2] = {2, 6};  // the curved side's rings fitted by the tangent test
+constexpr uint32_t kRimJunctionRings = 2;      // rim members this close to a junction stay (rim_tangent_angle)
+// Cells: how far from the flat's plane the tangent side's fitted points must
+// rise for the rim to leave it (a fillet does; the rounded estimate along a
+// box's crease stays within ~0.6 and fits a quadric that looks tangent).
+constexpr double kRimFilletRise = 1.5;
+// Junction test: points whose middle PCA eigenvalue is below this share of
+// the largest are a row (their plane is arbitrary).
+constexpr double kThinRow = 0.15;
+// Detector::restab (near-axis faces): candidates within kRestabRings rings
+// whose normal is within kRestabWindow degrees; searched when the plane stabs
+// less than kRestabTrigger of them (not below kRestabGiveUp), or always when
+// it lies within kRestabRange of a low-index direction (kLowIndex); a core
+// the acceptance tests refused, when it stabs at least kRestabForced; over directions
+// within kRestabRange degrees (kRestabSteps coarse steps each way, then two
+// 5 x 5 grids 4 and 16 times finer), with at most kRestabSample sticks;
+// taken when it stabs kRestabGain x as many; at most kRestabRounds rounds.
+// Measured on boxes, cylinders, tori, the CAD part and fandisk
+// (docs/ARCHITECTURE.md, Flats: Stabbing refit).
+constexpr int kRestabRings = 10;
+constexpr double kRestabWindow = 15;
+constexpr double kRestabTrigger = 0.9;
+constexpr double kRestabGiveUp = 0.75;
+constexpr double kRestabForced = 0.7;
+constexpr double kRestabRange = 4;
+constexpr int kRestabSteps = 4;
+constexpr size_t kRestabSample = 2000;
+constexpr double kRestabGain = 1.02;
+constexpr int kRestabRounds = 6;
+// The low-index lattice directions, one of each +- pair: the 3 axes, the 6
+// face diagonals and the 4 body diagonals (restab's near-lattice search).
+const std::array<Vec3, 13> kLowIndex = [] {
+  std::array<Vec3, 13> d;
+  size_t k = 0;
+  for (int a = 0; a <= 1; ++a)
+    for (int b = -1; b <= 1; ++b)
+      for (int c = -1; c <= 1; ++c)
+        if (a > 0 || b > 0 || (b == 0 && c > 0)) d[k++] = Vec3(a, b, c).normalized();
+  return d;
+}();
+
+
+// Equal-angle cube-map cell of a direction, and back (flat_geometry.cpp).
+uint32_t direction_cell(const Vec3& d);
+
+Vec3 cell_direction(uint32_t c);
+
+// Unit vectors spanning the plane orthogonal to unit n.
+void frame(const Vec3& n, Vec3& u, Vec3& v);
+
+constexpr int kMaxVotes = 7;  // a vertex's votes: its normal's cell and six around it
+int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out);
+
+// ---------------------------------------------------------------- planes
+using detail::fit_plane;
+using detail::Pca;
+using detail::pca;
+using detail::Plane;
+
+// The surface data the detector reads.
+struct Surface {
+  const StickSurface* s;
+  std::vector<Vec3> x, nrm;         // estimated vertex positions and unit normals (index space)
+  std::vector<double> area;         // a third of the incident triangle areas (index space)
+  std::vector<uint32_t> adj_off, adj;  // vertex adjacency (CSR)
+  // The estimated positions of vertices vs, into pts.
+  void positions(const std::vector<uint32_t>& vs, std::vector<Vec3>& pts) const {
+    pts.resize(vs.size());
+    for (size_t q = 0; q < vs.size(); ++q) pts[q] = x[vs[q]];
+  }
+  // Samples of stick v: inside and outside endpoints.
+  Vec3 inside(size_t v) const { return s->inside_sample(v); }
+  Vec3 outside(size_t v) const { return s->outside_sample(v); }
+};
+
+// t (from the inside sample) where the plane crosses stick v, or NaN when it
+// does not cross it with the margin.
+
+// t (from the inside sample) where the plane crosses stick v, or NaN when it
+// does not cross it with the margin.
+double crossing(const Surface& S, size_t v, const Plane& P, double margin);
+// The largest lambda in [0, 1] such that (1 - lambda) P0 + lambda P1 stabs
+// every stick of `cluster` with the margin (P0 does).
+double feasible_step(const Surface& S, const std::vector<uint32_t>& cluster, const Plane& P0, const Plane& P1,
+                     double m);
+
+class MinNorm {
+ public:
+  MinNorm(const std::vector<Eigen::Vector3d>& a, const std::vector<double>& b) : a_(a), b_(b), order_(a.size()) {
+    // A fixed pseudo-random order: deterministic results.
+    std::vector<std::pair<uint64_t, uint32_t>> key(a.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      uint64_t z = i + 0x9E3779B97F4A7C15ull;
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+      key[i] = {z ^ (z >> 31), uint32_t(i)};
+    }
+    std::sort(key.begin(), key.end());
+    for (size_t i = 0; i < a.size(); ++i) order_[i] = key[i].second;
+  }
+  bool solve(Eigen::Vector3d& w) {
+    int E[3];
+    return solve(order_.size(), E, 0, w);
+  }
+
+ private:
+  // The point of {a_e . w = b_e, e in E} nearest the origin.
+  bool project(const int* E, int k, Eigen::Vector3d& w) const {
+    if (k == 0) {
+      w.setZero();
+      return true;
+    }
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (int q = 0; q < k; ++q) {
+      A.col(q) = a_[size_t(E[q])];
+      rhs(q) = b_[size_t(E[q])];
+    }
+    const Eigen::MatrixXd Ak = A.leftCols(k);
+    const Eigen::MatrixXd G = Ak.transpose() * Ak;
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(G);
+    lu.setThreshold(1e-12);
+    if (lu.rank() < k) return false;
+    w = Ak * lu.solve(rhs.head(k));
+    return true;
+  }
+  bool solve(size_t count, int* E, int k, Eigen::Vector3d& w) {
+    if (!project(E, k, w)) return false;
+    for (size_t q = 0; q < count; ++q) {
+      const uint32_t i = order_[q];
+      if (a_[i].dot(w) >= b_[i] - 1e-12 * (1 + std::abs(b_[i]))) continue;
+      if (k == 3) return false;  // only rounding can get here
+      E[k] = int(i);
+      if (!solve(q, E, k + 1, w)) return false;
+    }
+    return true;
+  }
+  const std::vector<Eigen::Vector3d>& a_;
+  const std::vector<double>& b_;
+  std::vector<uint32_t> order_;
+};
+
+// A sample a plane must leave strictly on one side (crease_refit).
+
+struct SideConstraint {
+  Vec3 p;
+  bool outside;
+  auto operator<=>(const SideConstraint& o) const {
+    return std::tie(p.x(), p.y(), p.z(), outside) <=> std::tie(o.p.x(), o.p.y(), o.p.z(), o.outside);
+  }
+  bool operator==(const SideConstraint&) const = default;
+};
+constexpr double kSideMargin = 1e-6;  // cells: how strictly a SideConstraint's sample is on its side
+
+constexpr int kCenterRounds = 4;  // chord-midpoint sweeps of constrained_fit's centring
+
+// Section 3's plane refinement, our choice of "best": least squares inside
+// the feasible set. With n = n_F + a u + b v (n_F the least-squares normal
+// of the points, u, v orthonormal to it) and the plane n . (x - m) = c'
+// through the points' mean m, the squared residuals are a quadratic in
+// z = (a, b, c') minimised at z = 0, and "the plane stabs stick s with the
+// margin" is two linear inequalities in z. With H = L L^T the residuals'
+// Hessian and w = L^T z this is the minimum-norm point of a polytope.
+// `sides` adds one-sided constraints (crease_refit), linear in z as well.
+// With `center_within`, the plane then moves to the centre of the feasible
+// set (see there). Returns false when the cluster is infeasible or the solver fails
+// numerically (the caller keeps a feasible plane).
+
+// Section 3's plane refinement: least squares inside the feasible set
+// (flat_geometry.cpp).
+bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, const std::vector<Vec3>& pts,
+                     const Vec3& towards, double margin, Plane& out, const std::vector<SideConstraint>& sides = {},
+                     const std::vector<uint32_t>* center_within = nullptr);
+Plane lerp(const Plane& a, const Plane& b, double l);
+
+// The estimate's surface data: positions, smoothed normals, areas, adjacency.
+Surface make_surface(const StickSurface& s, const std::vector<double>& t);
+
+// The crease refit (crease_refit.cpp).
+bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg, std::vector<Plane>& planes,
+                  std::vector<uint8_t>& moved);
+
+}  // namespace voxpress::flats_impl
