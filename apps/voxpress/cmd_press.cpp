@@ -237,8 +237,8 @@ void register_press(CLI::App& app, Global& g) {
   std::string pass_names;
   for (const PassInfo& p : feature_passes()) pass_names += std::string(pass_names.empty() ? "" : ", ") + p.name;
   cmd->add_option("--disable-pass", c->disabled_passes,
-                  "Switch off a pass of the feature layer (repeat or comma-separate; docs/ARCHITECTURE.md, "
-                  "Passes): " + pass_names)
+                  "Switch off a pass of the feature layer (repeat or comma-separate; docs/ARCHITECTURE.md, The feature "
+                  "layer): " + pass_names)
       ->delimiter(',');
   sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");

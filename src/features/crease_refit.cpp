@@ -23,7 +23,7 @@
 namespace voxpress::flats_impl {
 
 // Beyond the paper: the flats' planes refitted with their creases' samples
-// (docs/ARCHITECTURE.md, Flats: Crease refit). A flat's own sticks pin its
+// (docs/ARCHITECTURE.md at d97b886, Flats: Crease refit). A flat's own sticks pin its
 // plane poorly about a lattice axis the face nearly contains (box 128 seed
 // 29: 0.13 degrees, 0.09 cell off at its corners, all its sticks still
 // stabbed), but the samples along its sharp edges know more. At a convex

@@ -162,7 +162,7 @@ struct Detector {
   // ~1.3. The default gain (FlatOptions::curved_gain) is 1.3: fandisk 256
   // seeds 1-3 drop from 27-36 flats to 13-14 and result->truth from
   // 0.060-0.064 to 0.055-0.057; the generated shapes are unchanged (1.2
-  // would refuse the box piece: docs/ARCHITECTURE.md, Flats: Curvature test).
+  // would refuse the box piece: docs/ARCHITECTURE.md at d97b886, Flats: Curvature test).
   bool curved(const std::vector<uint32_t>& core, const Plane& P) {
     std::vector<uint32_t> ext;
     neighbourhood(core, P, kCurvedRings, kCurvedWindow, ext);

@@ -39,7 +39,7 @@ constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 // cone of the cell's direction, so a face whose estimate its rounded edges
 // bend has far fewer voters than sticks: fandisk 128's two 600-cell side
 // faces had 46 in their best cell and were never tried with a share of 1
-// (docs/ARCHITECTURE.md, Flats: Greedy extraction).
+// (docs/ARCHITECTURE.md at d97b886, Flats: Greedy extraction).
 constexpr double kSeedShare = 0.3;
 // The curvature test (Detector::curved, FlatOptions::curved_gain): a flat's
 // neighbourhood is its core grown kCurvedRings rings over the vertices whose
@@ -64,7 +64,7 @@ constexpr double kThinRow = 0.15;
 // 5 x 5 grids 4 and 16 times finer), with at most kRestabSample sticks;
 // taken when it stabs kRestabGain x as many; at most kRestabRounds rounds.
 // Measured on boxes, cylinders, tori, the CAD part and fandisk
-// (docs/ARCHITECTURE.md, Flats: Stabbing refit).
+// (docs/ARCHITECTURE.md at d97b886, Flats: Stabbing refit).
 constexpr int kRestabRings = 10;
 constexpr double kRestabWindow = 15;
 constexpr double kRestabTrigger = 0.9;

@@ -46,7 +46,7 @@ constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
 // PressOptions::free_ends: pieces from barrier to barrier of at least this
 // many segments (7 vertices between the barriers) get free ends. Measured
 // 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
-// holes of plate_holes at 128^3 (docs/ARCHITECTURE.md).
+// holes of plate_holes at 128^3 (docs/ARCHITECTURE.md at d97b886).
 constexpr uint32_t kFreePiece = 8;
 
 // Slot of plane family a among the two families of a stick along axis b.
