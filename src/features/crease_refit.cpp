@@ -29,24 +29,24 @@ namespace voxpress::flats_impl {
 // stabbed), but the samples along its sharp edges know more. At a convex
 // crease the solid is the intersection of the flats' half-spaces, so each
 // inside sample there is inside every plane, and each outside sample is
-// outside at least one: the one plane it is not clearly (kCreaseClear)
+// outside at least one: the one plane it is not clearly (kRefitClear)
 // inside of, when there is one. At a concave crease (the union) the roles
 // swap. The samples considered are those of the junctions and members
-// within kCreaseRings rings of two or more flats, and within kCreaseWindow
+// within kRefitRings rings of two or more flats, and within kRefitWindow
 // of the plane they constrain. A flat whose plane leaves such a sample on
 // the wrong side is refitted: least squares of its members near the plane,
 // inside the set stabbing all its members and keeping every constraint
-// (constrained_fit), taken when it moves less than kCreaseTurn degrees.
+// (constrained_fit), taken when it moves less than kRefitTurn degrees.
 // With FlatOptions::center_planes every flat is refitted in the first round
 // and its plane moved to the centre of that feasible set (every member the
 // least-squares plane stabs staying stabbed).
 // Rounds until no plane moves. Returns whether any moved.
-constexpr int kCreaseRings = 2;
-constexpr int kCreaseReach = 8;
-constexpr double kCreaseWindow = 0.25;  // cells
-constexpr double kCreaseClear = 0.1;    // cells
-constexpr double kCreaseTurn = 1;       // degrees
-constexpr int kCreaseRounds = 3;
+constexpr int kRefitRings = 2;
+constexpr int kRefitReach = 8;
+constexpr double kRefitWindow = 0.25;  // cells
+constexpr double kRefitClear = 0.1;    // cells
+constexpr double kRefitTurn = 1;       // degrees
+constexpr int kRefitRounds = 3;
 bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg, std::vector<Plane>& planes,
                   std::vector<uint8_t>& moved) {
   const size_t n = S.x.size(), F = planes.size();
@@ -68,11 +68,11 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
     const int32_t own = seg.region[v];
     auto add = [&](int32_t f, const Vec3& p, bool outside) {
       const double h = height(f, p) * (outside ? 1 : -1);  // > 0: on its side
-      if (h < -kCreaseWindow) return;
+      if (h < -kRefitWindow) return;
       sc.sides.push_back({f, {p, outside}});
       if (h <= 0) sc.broken[size_t(f)] = 1;
     };
-    detail::rings_around(v, kCreaseRings, S.adj_off, S.adj, [](uint32_t) { return true; }, sc.rs);
+    detail::rings_around(v, kRefitRings, S.adj_off, S.adj, [](uint32_t) { return true; }, sc.rs);
     std::vector<int32_t>& near = sc.near;
     near.clear();
     detail::add_flats(sc.rs.out, seg.region, near);
@@ -90,7 +90,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
     if (own >= 0) return;  // a member's own plane separates its samples: the disjunction holds
     // The disjunction must know every plane that may bound the solid here
     // (a corner's third face, whose rim may stop a few rings short).
-    detail::rings_around(v, kCreaseReach, S.adj_off, S.adj, [](uint32_t) { return true; }, sc.wide);
+    detail::rings_around(v, kRefitReach, S.adj_off, S.adj, [](uint32_t) { return true; }, sc.wide);
     sc.wider = near;
     detail::add_flats(sc.wide.out, seg.region, sc.wider);
     // The sample that must be on the other side of one plane: the plane it is not clearly inside (outside) of.
@@ -99,17 +99,17 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
     int32_t pick = -1;
     bool clear = true;
     for (int32_t g : sc.wider)
-      if (sg * height(g, one) > -kCreaseClear) {
+      if (sg * height(g, one) > -kRefitClear) {
         if (pick >= 0) clear = false;
         pick = g;
       }
     if (pick >= 0 && clear) add(pick, one, convex);
   };
   std::vector<Vec3> pts;
-  for (int round = 0; round < kCreaseRounds; ++round) {
+  for (int round = 0; round < kRefitRounds; ++round) {
     // Ring distance to a border between regions (flats, curved): beyond
-    // kCreaseRings, no other flat is near and a member is inner.
-    const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, kCreaseRings, S.adj_off, S.adj);
+    // kRefitRings, no other flat is near and a member is inner.
+    const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, kRefitRings, S.adj_off, S.adj);
     tbb::enumerable_thread_specific<Scratch> scratch([F] {
       Scratch sc;
       sc.broken.assign(F, 0);
@@ -132,7 +132,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       if (!broken[f] && !(o.passes.on(Pass::center_planes) && round == 0)) continue;
       std::sort(sides[f].begin(), sides[f].end());
       sides[f].erase(std::unique(sides[f].begin(), sides[f].end()), sides[f].end());
-      // Fitted: the members more than kCreaseRings rings from any other
+      // Fitted: the members more than kRefitRings rings from any other
       // region (next to one, a member may be another face's stick the rim
       // took, which no plane near the true one stabs); the least squares
       // over those near the plane.
@@ -147,7 +147,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       Plane P;
       if (!constrained_fit(S, inner, pts, planes[f].n, kSideMargin, P, sides[f], o.passes.on(Pass::center_planes) ? &members[f] : nullptr))
         continue;
-      if (detail::degrees_between(P.n, planes[f].n) > kCreaseTurn) continue;
+      if (detail::degrees_between(P.n, planes[f].n) > kRefitTurn) continue;
       planes[f] = P;
       moved[f] = 1;
       again = true;

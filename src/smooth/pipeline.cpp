@@ -160,10 +160,7 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
         SharpenResult sr = sharpen(surface, r.flats, so);
         r.mesh = std::move(sr.mesh);
         r.sharpen = sr.stats;
-        for (size_t p = 0; p < size_t(Pass::count); ++p) {
-          r.pass_times.seconds[p] += sr.stats.passes.seconds[p];
-          r.pass_times.count[p] += sr.stats.passes.count[p];
-        }
+        r.pass_times.add(sr.stats.passes);
       } else {
         r.mesh = to_mesh(surface);
         if (features) add_region_attributes(r.mesh, r.flats, o.color_regions);

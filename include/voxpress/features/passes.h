@@ -79,6 +79,9 @@ struct PassTimes {
     seconds[size_t(p)] += s;
     count[size_t(p)] += n;
   }
+  void add(const PassTimes& other) {
+    for (size_t p = 0; p < size_t(Pass::count); ++p) add(Pass(p), other.seconds[p], other.count[p]);
+  }
 };
 
 }  // namespace voxpress
