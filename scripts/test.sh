@@ -23,9 +23,13 @@ cmake --build "$root/build-asan" -j "$(nproc)" --target "${suites[@]}" >&2
 phase "sanitized build done"
 # Each suite's executable directly (the CLI, Python and browser tests ran in
 # Release above), two at a time; any sanitizer report fails the suite. Left
-# out: the fidelity checks at 64-128^3 (10-160 s each under ASan), which run
-# the very code the property corpus runs, on bigger volumes; they passed in
-# Release above.
+# out (all passed in Release above): the fidelity checks at 64-128^3 (10-160 s
+# each under ASan), which run the very code the property corpus runs, on
+# bigger volumes; the 1-vs-N-thread comparisons (the sanitizers check memory,
+# not races, and every other test runs on all cores too); the flats' property
+# corpus (the sharpening's corpus runs press_with_flats on the same volumes);
+# the conversion of the shared voxel art (its parsing is checked by
+# Voxart.SharedFilesHaveTheDocumentedContents).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndItsCreasesAreFound:Sharpen.RotatedBoxesGetTheirEdgesBack:\
 Sharpen.SharpAngleOptionControlsTheLabels:Sharpen.ThinPlatesGetBothEdgesOfTheirRim:\
@@ -37,7 +41,10 @@ Sharpen.JoinedVerticesTakeTheNearestPlane:Sharpen.FandiskGetsMoreAccurate:\
 Pressing.MeetsTheFidelityTargetsOnSphereAndTorus:Pressing.QuadricFitBringsTightCurvesCloserToTheTruth:\
 Metrics.MidpointRowOfThePaperIsReproduced:Shapes.CadPartMeshIsAValidSolidMatchingItsClosedFormVolume:\
 Written.RotatedRealMeshKeepsTheGuaranteeInEveryFormat:\
-Written.AnisotropicPartFarFromTheOriginKeepsTheGuaranteeInEveryFormat:Passes.EachPassOffKeepsTheGuarantees"
+Written.AnisotropicPartFarFromTheOriginKeepsTheGuaranteeInEveryFormat:Passes.EachPassOffKeepsTheGuarantees:\
+Flats.FandiskPlanarFacesFoundAndStagesBeatTheMidpoint:Flats.PropertyCorpusKeepsEveryGuarantee:\
+Pipeline.SameMeshForOneAndManyThreadsOnThePropertyVolumes:Sharpen.SameResultForOneAndManyThreads:\
+Flats.SameResultForOneAndManyThreads:Voxart.SharedVoxelArtLoadsAndConverts"
 # smooth_tests, the longest, runs as two shards.
 runs=(smooth_tests:0:2 smooth_tests:1:2)
 for s in "${suites[@]}"; do if [ "$s" != smooth_tests ]; then runs+=("$s:0:1"); fi; done

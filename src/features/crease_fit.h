@@ -65,6 +65,7 @@ struct CurvedCreaseFit {
   double other_distance = 1;  // cells
   double margin = 0.01;       // t kept in [margin, 1 - margin]
   double max_move = 0.5;      // of the stick
+  bool network = true;        // keep only creases that continue a proven one (Pass::crease_network)
 };
 
 struct CurvedCrease {

@@ -24,8 +24,8 @@ namespace voxpress::flats_impl {
 
 // Beyond the paper: the flats' planes refitted with their creases' samples
 // (docs/ARCHITECTURE.md at d97b886, Flats: Crease refit). A flat's own sticks pin its
-// plane poorly about a lattice axis the face nearly contains (box 128 seed
-// 29: 0.13 degrees, 0.09 cell off at its corners, all its sticks still
+// plane poorly about a lattice axis the face nearly contains (a tenth of
+// a degree, a tenth of a cell off at its corners, all its sticks still
 // stabbed), but the samples along its sharp edges know more. At a convex
 // crease the solid is the intersection of the flats' half-spaces, so each
 // inside sample there is inside every plane, and each outside sample is

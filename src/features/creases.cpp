@@ -21,6 +21,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr size_t kSidePoints = 12;  // fewest points of a curved crease's side (Quadric::fit's minimum)
+constexpr uint32_t kChainGap = 2;  // rings a curved crease's chain may skip (a vertex whose sides' fit failed)
 
 }  // namespace
 
@@ -227,9 +228,45 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
         f.t = std::numeric_limits<double>::quiet_NaN();
     }
   });
+  // Evidence: a crease between two curved faces is kept only where it
+  // continues a proven crease. Locally it proves nothing: at 128^3 a tight
+  // fold of an organic solid (a bunny's neck, a heart's grooves) fits two
+  // quadrics meeting at a sharp angle as well as a CAD part's curved
+  // crease does, and the sharp-vs-rounded stick test cannot tell them
+  // apart either (docs/ARCHITECTURE.md, Curved creases). What does is the
+  // crease network: a CAD part's curved creases run into the sharp borders
+  // of its flats. So a found vertex seeds a chain when a vertex of a proven
+  // feature (role kCreaseSkip or kCreaseSide: a flat's junction, its crease
+  // zone, a thin wall) lies within the side fit's c.rings rings (closer in,
+  // the fit has too few side points to find the crease), and the chain
+  // goes on through found vertices at most kChainGap rings apart.
+  std::vector<uint8_t> is_found(n, 0), reached(n, 0);
+  for (const auto& f : found)
+    if (!std::isnan(f.t)) is_found[f.v] = 1;
+  std::vector<uint32_t> chain;
+  RingScratch rs;
+  for (const auto& f : found) {
+    if (std::isnan(f.t)) continue;
+    rings_around(f.v, c.rings, off, adj, [](uint32_t) { return true; }, rs);
+    if (std::any_of(rs.out.begin(), rs.out.end(),
+                    [&](const auto& wd) { return role[wd.first] != kCreaseFree && region[wd.first] < 0; })) {
+      reached[f.v] = 1;
+      chain.push_back(f.v);
+    }
+  }
+  while (!chain.empty()) {
+    const uint32_t u = chain.back();
+    chain.pop_back();
+    rings_around(u, kChainGap, off, adj, [](uint32_t) { return true; }, rs);
+    for (const auto& [w, d] : rs.out)
+      if (is_found[w] && !reached[w]) {
+        reached[w] = 1;
+        chain.push_back(w);
+      }
+  }
   std::vector<CurvedCrease> out;
   for (const auto& f : found)
-    if (!std::isnan(f.t)) out.push_back(f);
+    if (!std::isnan(f.t) && (reached[f.v] || !c.network)) out.push_back(f);
   if (normals) *normals = std::move(vn);
   return out;
 }
@@ -269,6 +306,7 @@ size_t fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const Fl
   detail::CurvedCreaseFit c;
   c.sharp_angle = o.junction_angle;
   c.margin = o.margin;
+  c.network = o.passes.on(Pass::crease_network);
   const auto found = detail::curved_crease_targets(s, seg.region, role, x, off, adj, c);
   for (const auto& f : found) {
     s.t[f.v] = s.lower_inside(f.v) ? f.t : 1 - f.t;

@@ -41,8 +41,8 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   PressOptions eo = po;
   eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
   // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
-  // 3, CAD part 256 seed 30 gains a 242-stick piece of a face, 3.4 degrees
-  // off it, that no plane merges back).
+  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
+  // that no plane merges back).
   eo.levels = 2;
   eo.tolerance = 0;
   eo.progress = nullptr;
@@ -50,7 +50,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   press(est, curves, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
-  // piece of a face (box 64 seed 15: 1.8 degrees off) changed the second
+  // piece of a face (a couple of degrees off) can change the second
   // estimate enough to lose that face.
   FlatOptions early = *fo;
   early.passes.disable(Pass::crease_refit);

@@ -161,8 +161,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     progress.add(1);
   }
   // ---- Merge (beyond the paper): the greedy growth can take one face as
-  // two flats, each fitted to a piece whose estimate leans its own way (CAD
-  // part 64 seed 50: a piece of the plate's side 2.5 degrees off). Adjacent
+  // two flats, each fitted to a piece whose estimate leans its own way (a
+  // piece of a plate's side a few degrees off). Adjacent
   // flats whose normals are within merge_angle become one when one plane
   // stabs the sticks of both cores (the constrained fit) and, of their
   // members, at least 90 %; the rim is then grown again around them.
@@ -188,9 +188,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     // past the face's rounded edges. When that plane stabs fewer than `need`
     // of their members (or none stabs the cores), each flat's own plane is
     // tried too: a face split into an accurate piece and one whose core
-    // reaches onto a rounded edge (CAD part 128 seed 1's chamfer since the
-    // circle correction: 0.26 degrees apart, no plane stabbing both cores,
-    // each plane stabbing 98 % of the other's members). Returns the members
+    // reaches onto a rounded edge (a chamfer's two pieces a quarter of a
+    // degree apart, no plane stabbing both cores, each plane stabbing
+    // nearly all of the other's members). Returns the members
     // the chosen plane P stabs.
     auto joint = [&](size_t a, size_t b, double need, Plane& P) {
       std::vector<uint32_t> core, stabbed;
@@ -328,11 +328,11 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           // flat are its rim stopped short, not the curved side. Left in,
           // where a rim stopped a cell or two short of a crease the plane
           // leaned halfway between the two sides, under junction_angle
-          // (CAD part 128 seed 30's boss rim: 26.6 degrees), so no junction
+          // (a boss's rim), so no junction
           // marked the crease and the flat never reached it. Without them
           // the points can be a thin row along the crease, whose plane is
-          // any plane through it (box 128 seed 8: the crease refit then
-          // moved a face 0.1 cell); then all of them are used.
+          // any plane through it (the crease refit then moves the face
+          // by its error); then all of them are used.
           Pca q;
           bool off_plane = false;  // q is the plane of the points off the flat's plane
           if (o.passes.on(Pass::ring_off_plane)) {
@@ -369,10 +369,10 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             // rounded there (there is no crease to round), so the tangent
             // test's quadric is good and its normal at the flat is the
             // flat's: smooth. Each flat is judged on its own: a fillet
-            // tangent to one flat can meet another at a crease (CAD part
-            // 128 seed 3: 35 and 75 degrees from the two flats beside one
-            // vertex; judging the tangent one alone left a gap in the
-            // other's crease, 0.72 voxel from any label).
+            // tangent to one flat can meet another at a crease (a
+            // vertex between two flats can lean 35 degrees from one and 75
+            // from the other: judging the tangent one alone leaves a gap
+            // in the other's crease).
             sharp = false;
             for (size_t i = 0; i < leaning_count && !sharp; ++i)
               sharp = !(o.passes.on(Pass::tangent_borders) && tangent(uint32_t(v), leaning[i], cos_j, 0, rs, pts));

@@ -202,8 +202,8 @@ struct Detector {
   // containing one, the estimate of a face between sharp edges is a pillow:
   // Pressing bulges it up to a cell outwards over ten cells, since the
   // sticks of such a face bound its slope only loosely. The core then holds
-  // a piece of the face, tilted 1-3 degrees (box 128 seed 15: three such
-  // pieces instead of two faces). The truth stabs every stick of the face
+  // a piece of the face, tilted 1-3 degrees (several such pieces instead of
+  // the faces). The truth stabs every stick of the face
   // whatever the estimate, so: when the plane stabs less than
   // kRestabTrigger of the candidates (the core and the unassigned vertices
   // within kRestabRings rings whose normal is within kRestabWindow of the
@@ -222,12 +222,11 @@ struct Detector {
     // in layers across such a normal, so a plane tilted a little from it
     // crosses few layers, and a plane along the direction through one of
     // them stabs most of the face's sticks while lying up to half a cell
-    // off. The CAD part's end faces at 128^3 seed 15 lie 2 degrees off z
-    // and rise 1.1 cells across: an axis-aligned plane through one terrace
-    // stabbed 0.90-0.92 of their candidates (or, once a flat took that
-    // terrace, a plane through the next one 0.70); box 128 seed 48's face 1
-    // degree off a face diagonal left a 3-degree plane through one layer as
-    // a seventh flat. An accepted core's plane there is always searched; a
+    // off. A face 2 degrees off z that rises a cell across has an
+    // axis-aligned plane through one terrace stabbing some 90 % of its
+    // candidates (or, once a flat took that terrace, a plane through the
+    // next one 70 %); a face a degree off a face diagonal can leave a
+    // plane 3 degrees off through one layer as an extra flat. An accepted core's plane there is always searched; a
     // refused core's still from kRestabForced (cylinders' tangent strips
     // near a diagonal would cost their detection 80 % more). The result is
     // still kept only when it reaches kRestabTrigger; a face on the
@@ -244,8 +243,8 @@ struct Detector {
       // neighbourhood stays, and one far from explaining it (next to a
       // gently curved face: 0.46-0.68 on fandisk) is not searched: the
       // search would tilt it into that face. Forced (a rejected core), the
-      // plane is searched from kRestabForced: the CAD part's 45-degree
-      // chamfer at 128^3 seed 20 is rounded from both sides, its cores lean
+      // plane is searched from kRestabForced: a 45-degree chamfer a
+      // few cells wide is rounded from both sides, its cores lean
       // 3-4 degrees, are refused, and stab 0.70-0.74 (at 0.9 they were not
       // searched, at 0.6 tori and fandisk at 256 paid 2-3x the detection
       // time for nothing). Cylinders reject hundreds of tangent-strip cores,

@@ -25,6 +25,8 @@ const std::vector<PassInfo>& feature_passes() {
        "curved vertices next to a sharp flat border placed by the curved side's quadric"},
       {Pass::curved_creases, "curved-creases", "beyond the paper",
        "creases between two curved faces placed by both sides' quadrics and sharpened"},
+      {Pass::crease_network, "crease-network", "beyond the paper",
+       "a crease between curved faces is kept only where it continues a flat's sharp border (off: wherever found)"},
       {Pass::free_ends, "free-ends", "Section 4, beyond the paper", "slice curves cut at barriers keep open ends"},
       {Pass::quadric_fit, "quadric-fit", "beyond the paper", "curved vertices moved onto their local quadric"},
       {Pass::sharpen, "sharpen", "Section 5", "chamfers split and moved onto the creases (off: no sharp edges)"},

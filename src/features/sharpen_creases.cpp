@@ -313,11 +313,11 @@ void Sharpener::curved_creases() {
   detail::CurvedCreaseFit c;
   c.sharp_angle = o.sharp_angle;
   c.margin = o.margin;
+  c.network = o.passes.on(Pass::crease_network);
   // A thin wall's vertices are junctions on their wall's fitted plane, a
   // face of their own: they stay, but are the wall's side of a crease
-  // with a curved face (fandisk 128 seed 1: a wall's 60-90 degree crease
-  // with a curved face was unlabelled for 9 voxels; without its vertices
-  // the 2-means saw one side only).
+  // with a curved face (without its vertices the 2-means sees one side
+  // only, and a wall's steep crease with a curved face goes unlabelled).
   std::vector<uint8_t> role(n);
   for (size_t v = 0; v < n; ++v)
     role[v] = !junction[v] ? detail::kCreaseFree : on_wall[v] ? detail::kCreaseSide : detail::kCreaseSkip;

@@ -116,7 +116,7 @@ void Sharpener::snap_to_flats() {
     for (uint32_t v : patch) explained += flat[v] >= 0;
     // A corner patch whose third face's flat stops more than snap_rings
     // rings away: the two near flats explain most of it, the rest only
-    // with the third (box 128 seeds 39 and 48). Its unexplained vertices
+    // with the third. Its unexplained vertices
     // look twice as far; a curved face, mostly unexplained, is not retried.
     if (explained >= patch.size() / 2 && double(explained) < detail::kSnapShare * double(patch.size()))
       for (uint32_t v : patch)
@@ -153,10 +153,9 @@ void Sharpener::join_leftovers() {
     int32_t best = -1;
     double best_d = INFINITY;
     // Every flat with a member within 3 rings competes: taking the first
-    // ring that reaches one had a vertex of the CAD part's bottom rim
-    // (128 seed 5) join the bottom's flat 1.04 cells below its plane
-    // while 0.15 from the side face's, and the crease chain detoured
-    // 0.94 voxel around it.
+    // ring that reaches one can have a vertex of a bottom rim join the
+    // bottom's flat a cell below its plane while a tenth of a cell from
+    // the side face's, and the crease chain detours around it.
     ring.assign(1, v);
     detail::grow_rings(ring, 3, adj_off, adj);
     for (uint32_t q : ring) {

@@ -98,11 +98,9 @@ void Sharpener::subdivide() {
       // Beyond the paper: where a corner's third plane is missing (a
       // curved junction without a fit of its own, squeezed between two
       // flats), it goes onto the line of the other two; left at the
-      // centroid, its three labelled edges made a spur off the crease
-      // (CAD part 128 seed 128: 0.67 voxel off a crease of two flats).
+      // centroid, its three labelled edges make a spur off the crease.
       // Where all three planes meet too far away it stays: the line of
-      // two flats then runs on past the end of their crease (seed 26:
-      // 0.59 -> 0.66 voxel from any true crease had it moved there).
+      // two flats then runs on past the end of their crease.
       if (!c.moves && (p[0] != nullptr) + (p[1] != nullptr) + (p[2] != nullptr) == 2) {
         const int i = p[0] ? 0 : 1, j = p[2] ? 2 : 1;
         if (1 - std::abs(p[i]->n.dot(p[j]->n)) >= floor2) {

@@ -344,8 +344,7 @@ struct Sharpener {
   // 2-ring plane meets the flat at sharp_angle or more) become junctions,
   // as past_creases does for its joins. Otherwise their edges to the joined
   // vertex are no chamfer edges (chamfer()) and the sharp curve has a gap
-  // there (CAD part 128 seed 1: 2 cells of the boss's rim, true -> labelled
-  // 1.0 voxel). A thin strip's vertex joins off the plane (join_leftovers)
+  // there. A thin strip's vertex joins off the plane (join_leftovers)
   // and moves no border: at 64^3 its heirs labelled a false crease.
   void inherit_junctions();
   // Section 3's junction test on the border a vertex v that joined a flat
@@ -436,12 +435,11 @@ struct Sharpener {
   //  * A curved junction vertex whose stick leaves that solid on the flat's
   //    plane joins the flat there (a slide along the stick: no sample
   //    changes side). A stick that never climbs the side's plane and lies
-  //    below it leaves the solid on the flat's plane (leaves_at: CAD part
-  //    128 seed 10, a curved junction at a sample 0.76 voxel from the
-  //    crease; left curved, the chain detoured 0.85 voxel around it). A
-  //    stick nearly parallel to the flat may not cross its plane at all
-  //    (CAD part 128 seed 13: two curved vertices at a sample 1.3 voxels
-  //    from the crease, the chain looping out to them): when the vertex
+  //    below it leaves the solid on the flat's plane (leaves_at; left
+  //    curved, the chain detours around such a vertex). A stick nearly
+  //    parallel to the flat may not cross its plane at all (the chain
+  //    then loops out to vertices at a sample a voxel from the crease):
+  //    when the vertex
   //    lies within kPastSample of the flat's plane and more than that
   //    inside the side's half-space (outside at a concave crease), it joins
   //    where it is.
@@ -479,9 +477,9 @@ struct Sharpener {
   // (a flat's plane is the better fit and stays), and the edge vertex goes
   // to the new line when the other samples stay on their sides and it is
   // within max_move; otherwise it stays where it was inserted. False: stay.
-  // Edges between two flats or two curved sides are not checked: left in
-  // place there, box 128 seed 48 (faces 1.2 degrees off z) went from 0.013
-  // to 0.69 voxel.
+  // Edges between two flats or two curved sides are not checked (a chamfer
+  // between faces a degree off an axis, left in place, lies most of a voxel
+  // from the crease).
   bool sample_wedge(uint32_t a, uint32_t b, const Plane& pa, const Plane& pb, const Vec3& start, double floor2,
                     Vec3& target) {
     if ((label[a] < 0) == (label[b] < 0)) return true;  // two flats or two curved sides: no plane to move

@@ -286,6 +286,40 @@ TEST(Sharpen, AdversarialRotatedBoxUnionsKeepEveryGuarantee) {
   }
 }
 
+TEST(Sharpen, CurvedCreasesOnlyWhereTheyContinueAFlatsCrease) {
+  // A box beside a lens (two spheres' intersection: a circular crease of
+  // about 70 degrees between two curved faces, tilted off the lattice).
+  // The box's flats make the layer run; the lens' crease joins no flat's
+  // border, so crease-network keeps it rounded; switched off, it is labelled.
+  const int64_t nx = 80, n = 40;
+  BinaryVolume v = test::make_volume(nx, n, n);
+  const Vec3 axis = Vec3(1, 2, 3).normalized(), centre(58, 20, 20);
+  for (int64_t z = 0; z < n; ++z)
+    for (int64_t y = 0; y < n; ++y)
+      for (int64_t x = 0; x < nx; ++x) {
+        const Vec3 p{double(x), double(y), double(z)};
+        const bool box = x >= 4 && x <= 34 && y >= 6 && y <= 33 && z >= 7 && z <= 32;
+        const bool lens = (p - centre - 8 * axis).norm() < 14 && (p - centre + 8 * axis).norm() < 14;
+        v.inside[v.lattice.linear(x, y, z)] = box || lens;
+      }
+  auto lens_edges = [](const Sharpened& r) {
+    size_t count = 0;
+    for (const auto& e : r.after.edges) count += r.after.positions[e[0]].x() > 40 && r.after.positions[e[1]].x() > 40;
+    return count;
+  };
+  const Sharpened on = run(v, {}, {}, {}, true);
+  expect_valid(on.after, v);
+  EXPECT_GT(on.after.edges.size(), 0u) << "the box keeps its edges";
+  EXPECT_EQ(lens_edges(on), 0u);
+  FlatOptions fo;
+  SharpenOptions so;
+  fo.passes.disable(Pass::crease_network);
+  so.passes.disable(Pass::crease_network);
+  const Sharpened off = run(v, fo, {}, so, true);
+  expect_valid(off.after, v);
+  EXPECT_GT(lens_edges(off), 20u) << "without the network the lens' crease is labelled";
+}
+
 TEST(Sharpen, SameResultForOneAndManyThreads) {
   const GeneratedShape g = shape(ShapeKind::cad_part, 72, 3);
   Sharpened a, b;

@@ -29,6 +29,7 @@ enum class Pass : uint8_t {
   center_planes,      // beyond: each plane moves to the centre of its feasible set
   crease_fit,         // beyond: curved vertices next to a junction placed by the curved side's quadric
   curved_creases,     // beyond: creases between two curved faces placed and sharpened
+  crease_network,     // beyond: ... only where they continue a flat's crease (evidence)
   free_ends,          // beyond (Section 4): slice curves cut at barriers keep open, clamped ends
   quadric_fit,        // beyond: curved vertices moved onto their neighbourhood's quadric after pressing
   sharpen,            // Section 5: chamfer edges split, new vertices moved onto the creases
