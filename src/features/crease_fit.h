@@ -85,10 +85,13 @@ enum CreaseRole : uint8_t {
 // (intersection of the quadrics' insides at a convex crease, union at a
 // concave one), in vertex order; region = flat id or -1 per vertex, role =
 // CreaseRole per vertex, x = positions (index space), off / adj = vertex
-// adjacency. `normals` (optional) receives the physical vertex normals used.
+// adjacency. `normals` (optional) receives the physical vertex normals used,
+// `unproven` (optional) the number of creases found but dropped because no
+// proven crease continues into them (c.network).
 std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
                                                 const std::vector<uint8_t>& role, const std::vector<Vec3>& x,
                                                 const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
-                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals = nullptr);
+                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals = nullptr,
+                                                size_t* unproven = nullptr);
 
 }  // namespace voxpress::detail

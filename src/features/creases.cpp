@@ -12,6 +12,7 @@
 #include "crease_fit.h"
 #include "feature_tuning.h"
 #include "smooth/quadric.h"
+#include "smooth/stick_solid.h"
 #include "smooth/surface_graph.h"
 #include "voxpress/features/flats.h"
 
@@ -79,8 +80,8 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
       if (std::isnan(tc)) continue;
       // The flat's plane (index space) and the rule between the two sides.
       const Flat& f = flats[size_t(flat[v])];
-      const double fi = f.index_normal.dot(in) - f.index_offset, fo = f.index_normal.dot(out) - f.index_offset;
-      const double tf = fi >= 0 ? -kInf : fo <= 0 ? kInf : -fi / (fo - fi);
+      double tf = leave(Plane{f.index_normal, f.index_offset}, in, out);
+      if (std::isnan(tf)) tf = -kInf;  // the stick enters the flat's half-space: never in it before
       const bool convex = f.index_normal.dot(Q.m) < f.index_offset;
       const double t = std::clamp(convex ? std::min(tc, tf) : std::max(tc, tf), c.margin, 1 - c.margin);
       if (std::abs(t - tv) <= c.max_move) t_new[i] = t;
@@ -95,7 +96,7 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
 std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
                                                 const std::vector<uint8_t>& role, const std::vector<Vec3>& x,
                                                 const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
-                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals) {
+                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals, size_t* unproven) {
   const size_t n = region.size();
   const Mat3 Minv_t = sticks.lattice.index_to_physical_matrix().inverse().transpose();
   std::vector<Vec3> vn(n, Vec3::Zero());
@@ -196,17 +197,8 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       const bool convex = ga < 0;
       const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
       const double tv = (x[v] - in).dot(out - in);
-      // Where the stick leaves a side's solid; a stick the quadric does not
-      // cross is inside it (or outside) all along.
-      auto leave = [&](const Quadric& Q) {
-        const double t = Q.exit(in, out, tv, -1, 2);
-        if (!std::isnan(t)) return t;
-        const double gi = Q.n.dot(in - Q.foot(in)), go = Q.n.dot(out - Q.foot(out));
-        if (gi < 0 && go < 0) return kInf;
-        if (gi > 0 && go > 0) return -kInf;
-        return t;
-      };
-      const double ta = leave(QA), tb = leave(QB);
+      // Where the stick leaves each side's solid.
+      const double ta = leave(QA, in, out, tv), tb = leave(QB, in, out, tv);
       if (std::isnan(ta) || std::isnan(tb)) continue;
       const double t = std::clamp(convex ? std::min(ta, tb) : std::max(ta, tb), c.margin, 1 - c.margin);
       if (std::abs(t - tv) > c.max_move) continue;
@@ -265,8 +257,15 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       }
   }
   std::vector<CurvedCrease> out;
-  for (const auto& f : found)
-    if (!std::isnan(f.t) && (reached[f.v] || !c.network)) out.push_back(f);
+  if (unproven) *unproven = 0;
+  for (const auto& f : found) {
+    if (std::isnan(f.t)) continue;
+    if (reached[f.v] || !c.network) {
+      out.push_back(f);
+    } else if (unproven) {
+      ++*unproven;
+    }
+  }
   if (normals) *normals = std::move(vn);
   return out;
 }

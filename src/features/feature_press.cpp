@@ -76,6 +76,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     seg = find_flats(s, curves, est.t, pass + 1 < detail::kDetectionPasses ? early : *fo);
     seg.stats.seconds_detect += before.seconds_detect;
     seg.stats.seconds_junctions += before.seconds_junctions;
+    for (size_t p = 0; p < size_t(Pass::count); ++p) seg.stats.passes.seconds[p] += before.passes.seconds[p];
   }
   seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
@@ -114,7 +115,12 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     st.press.last_max_change = ps.last_max_change;
   }
   st.flats = seg.stats;
-  st.passes.add(Pass::flats, seg.stats.seconds_estimate + seg.stats.seconds_detect + seg.stats.seconds_junctions,
+  // The detection's own passes are timed apart: `flats` is the rest.
+  double sub = 0;
+  for (size_t p = 0; p < size_t(Pass::count); ++p) sub += seg.stats.passes.seconds[p];
+  st.passes.add(seg.stats.passes);
+  if (po.free_ends) st.passes.count[size_t(Pass::free_ends)] = seg.stats.barriers;  // the curves' cut points
+  st.passes.add(Pass::flats, seg.stats.seconds_estimate + seg.stats.seconds_detect + seg.stats.seconds_junctions - sub,
                 seg.flats.size());
   if (out) *out = std::move(seg);
   return st;

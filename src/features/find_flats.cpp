@@ -18,6 +18,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -114,9 +115,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // Members were stabbed with the margin; only rounding could put t a hair
   // outside it, so clamp (the sign test cannot fail: see crossing).
   auto frozen_t = [&](uint32_t v, const Plane& P) {
-    const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
-    if (!(fi < 0 && fo > 0)) throw std::logic_error("find_flats: a flat's plane does not cross one of its sticks");
-    return std::clamp(-fi / (fo - fi), o.margin, 1 - o.margin);
+    const double t = detail::leave(P, S.inside(v), S.outside(v));
+    if (!(t >= 0 && t <= 1)) throw std::logic_error("find_flats: a flat's plane does not cross one of its sticks");
+    return std::clamp(t, o.margin, 1 - o.margin);
   };
   std::vector<uint32_t> seeds;
   auto unvote = [&](uint32_t v) {  // drops the stick's votes from the accumulator
@@ -166,6 +167,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // flats whose normals are within merge_angle become one when one plane
   // stabs the sticks of both cores (the constrained fit) and, of their
   // members, at least 90 %; the rim is then grown again around them.
+  const auto t_merge = std::chrono::steady_clock::now();
   if (o.passes.on(Pass::merge) && seg.flats.size() > 1) {
     const double cos_merge = std::cos(detail::kMergeAngle * kPi / 180);
     detail::RingScratch rs;
@@ -249,6 +251,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
           members[b].clear();
           planes[a] = P;
           merged = true;
+          ++seg.stats.passes.count[size_t(Pass::merge)];
         }
       }
     }
@@ -265,6 +268,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       if (seg.region[v] >= 0) seg.region[v] = id[size_t(seg.region[v])];
     seg.flats = std::move(kept);
   }
+  seg.stats.passes.seconds[size_t(Pass::merge)] = seconds_since(t_merge);
+  seg.stats.passes.count[size_t(Pass::stab_refit)] = det.restabbed;
+  seg.stats.passes.count[size_t(Pass::curved_test)] = det.refused_curved;
   seg.stats.seconds_detect = seconds_since(t0);
 
   // ---- Junctions (Section 3): fresh vertices next to a frozen one whose
@@ -310,8 +316,13 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     const Vec3 foot = p - (F.normal.dot(p) - F.offset) * F.normal;
     return std::abs(Q.normal_at(foot).dot(F.normal)) >= cos_max;
   };
+  // The last detection's smooth borders (tangent-borders) and junction
+  // planes of the off-plane points (ring-off-plane).
+  std::atomic<size_t> smooth_borders{0}, off_plane_junctions{0};
   auto detect_junctions = [&] {
-  std::fill(seg.junction.begin(), seg.junction.end(), 0);
+    std::fill(seg.junction.begin(), seg.junction.end(), 0);
+    smooth_borders = 0;
+    off_plane_junctions = 0;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
       std::vector<Vec3> pts;
       detail::RingScratch& rs = scratch.local();
@@ -344,6 +355,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             if (pts.size() >= 3) {
               q = pca(pts);
               off_plane = q.eigenvalues(1) >= kThinRow * q.eigenvalues(2);
+              if (off_plane) ++off_plane_junctions;
             }
           }
           if (!off_plane) {
@@ -376,6 +388,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
             sharp = false;
             for (size_t i = 0; i < leaning_count && !sharp; ++i)
               sharp = !(o.passes.on(Pass::tangent_borders) && tangent(uint32_t(v), leaning[i], cos_j, 0, rs, pts));
+            if (!sharp && leaning_count > 0) ++smooth_borders;
           }
         }
         seg.junction[v] = sharp;
@@ -415,7 +428,9 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     if (stale) detect_junctions();
     stale = false;
     // Beyond the paper: the planes also keep their creases' samples on the right side.
-    const bool refit = o.passes.on(Pass::crease_refit) && crease_refit(S, o, seg, planes, refitted);
+    const auto t_refit = std::chrono::steady_clock::now();
+    const bool refit = o.passes.on(Pass::crease_refit) && crease_refit(S, o, seg, planes, refitted, seg.stats.passes);
+    seg.stats.passes.seconds[size_t(Pass::crease_refit)] += seconds_since(t_refit);
     if (refit) {
       for (size_t f = 0; f < planes.size(); ++f)
         if (refitted[f]) seg.flats[f] = flat_of(planes[f]);
@@ -460,6 +475,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   // members next to the border (one ring) go back to the curved side, unless
   // a junction is within two rings (the rim is the flat's reach to that
   // crease).
+  const auto t_rim = std::chrono::steady_clock::now();
   if (o.passes.on(Pass::rim_tangent) && !seg.flats.empty()) {
     const double cos_t = std::cos(detail::kRimTangentAngle * kPi / 180);
     std::vector<uint32_t> near_junction(n, detail::kUnreached), near_tangent(n, detail::kUnreached), junctions;
@@ -500,8 +516,10 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
         ++released;
       }
     seg.stats.rim_released = released;
+    seg.stats.passes.count[size_t(Pass::rim_tangent)] = released;
     if (released > 0) detect_junctions();
   }
+  seg.stats.passes.seconds[size_t(Pass::rim_tangent)] = seconds_since(t_rim);
   // Sizes, once the extension has settled the members. Index-space area ->
   // physical: |det M| |M^-T n| for a plane of unit index normal n.
   for (Flat& f : seg.flats) f.sticks = 0, f.area_cells = 0;
@@ -529,6 +547,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     seg.stats.junctions += seg.junction[v];
     seg.stats.barriers += seg.barrier[v];
   }
+  seg.stats.passes.count[size_t(Pass::tangent_borders)] = smooth_borders;
+  seg.stats.passes.count[size_t(Pass::ring_off_plane)] = off_plane_junctions;
   seg.stats.seconds_junctions = seconds_since(t1);
   return seg;
 }

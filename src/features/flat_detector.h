@@ -24,6 +24,7 @@ struct Detector {
 
   double cos_cone;
   std::vector<uint8_t> rim;  // per vertex: added by a rim growth (not a core member)
+  size_t restabbed = 0, refused_curved = 0;  // cores the stab refit changed, flats the curved test refused
   // A core vertex: its stick stabbed, its estimated vertex within tol of the
   // plane and its estimated normal within the cone of the plane's.
   // With `slack` > 0 the plane may miss the stick by up to that fraction of
@@ -31,9 +32,7 @@ struct Detector {
   bool near(uint32_t v, const Plane& P, double tol, double slack = 0) const {
     if (S.nrm[v].dot(P.n) < cos_cone || std::abs(P.n.dot(S.x[v]) - P.c) > tol) return false;
     if (slack <= 0) return !std::isnan(crossing(S, v, P, o.margin));
-    const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
-    if (!(fo > fi)) return false;
-    const double t = -fi / (fo - fi);
+    const double t = detail::leave(P, S.inside(v), S.outside(v));  // +-inf, NaN fail the test
     return t >= o.margin - slack && t <= 1 - o.margin + slack;
   }
 
@@ -133,9 +132,13 @@ struct Detector {
         core.swap(again);
         P = Q;
         ok = true;
+        ++restabbed;
       }
     }
-    if (ok && o.passes.on(Pass::curved_test) && curved(core, P)) ok = false;
+    if (ok && o.passes.on(Pass::curved_test) && curved(core, P)) {
+      ok = false;
+      ++refused_curved;
+    }
     if (!ok) {
       rejected = std::move(core);
       return {};
@@ -171,7 +174,7 @@ struct Detector {
     detail::Quadric Q;
     if (!Q.fit(pts, P.n)) return false;
     size_t by_quadric = 0;
-    for (uint32_t v : ext) by_quadric += !std::isnan(Q.exit(S.inside(v), S.outside(v), 0.5, o.margin, 1 - o.margin));
+    for (uint32_t v : ext) by_quadric += !std::isnan(detail::stab(Q, S.inside(v), S.outside(v), 0.5, o.margin));
     return double(by_quadric) > detail::kCurvedGain * double(stabbed_by(ext, P));
   }
 

@@ -81,10 +81,7 @@ int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out) {
 
 
 double crossing(const Surface& S, size_t v, const Plane& P, double margin) {
-  const double fi = P.n.dot(S.inside(v)) - P.c, fo = P.n.dot(S.outside(v)) - P.c;
-  if (!(fi < 0 && fo > 0)) return std::numeric_limits<double>::quiet_NaN();
-  const double t = -fi / (fo - fi);
-  return t >= margin && t <= 1 - margin ? t : std::numeric_limits<double>::quiet_NaN();
+  return detail::stab(P, S.inside(v), S.outside(v), margin);
 }
 
 // The largest lambda in [0, 1] such that (1 - lambda) P0 + lambda P1 stabs

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "feature_tuning.h"
+#include "smooth/stick_solid.h"
 #include "smooth/surface_graph.h"
 #include "voxpress/features/flats.h"
 
@@ -226,6 +227,6 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t);
 
 // The crease refit (crease_refit.cpp).
 bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg, std::vector<Plane>& planes,
-                  std::vector<uint8_t>& moved);
+                  std::vector<uint8_t>& moved, PassTimes& passes);
 
 }  // namespace voxpress::flats_impl

@@ -322,7 +322,8 @@ void Sharpener::curved_creases() {
   for (size_t v = 0; v < n; ++v)
     role[v] = !junction[v] ? detail::kCreaseFree : on_wall[v] ? detail::kCreaseSide : detail::kCreaseSkip;
   std::vector<Vec3> normal;
-  const auto found = detail::curved_crease_targets(s, label, role, x, adj_off, adj, c, &normal);
+  const auto found =
+      detail::curved_crease_targets(s, label, role, x, adj_off, adj, c, &normal, &st.passes.count[size_t(Pass::crease_network)]);
   for (const auto& f : found) {
     slide(f.v, f.t);
     if (plane_state[f.v] != 0) continue;

@@ -91,7 +91,10 @@ void Sharpener::thin_strips(std::vector<uint8_t>& mark) {
                          [&](uint32_t, uint32_t w) { return label[w] < 0; });
   }
   for (uint32_t v = 0; v < n; ++v)
-    if (thin[v]) mark[v] = near_deep[v] == detail::kUnreached ? kStrip : kRimStrip;
+    if (thin[v]) {
+      mark[v] = near_deep[v] == detail::kUnreached ? kStrip : kRimStrip;
+      ++st.passes.count[size_t(mark[v] == kStrip ? Pass::strips : Pass::rim_pockets)];
+    }
 }
 
 void Sharpener::snap_to_flats() {

@@ -24,6 +24,7 @@
 #include "crease_fit.h"
 #include "feature_tuning.h"
 #include "smooth/quadric.h"
+#include "smooth/stick_solid.h"
 #include "smooth/surface_graph.h"
 
 #include "voxpress/features/sharpen.h"
@@ -141,11 +142,7 @@ struct Sharpener {
   // not climb (it never leaves), -inf when it lies wholly above one (it is
   // never in); NaN when it enters the half-space on its way out.
   double leaves_at(uint32_t v, const Plane& p) const {
-    const double hi = p.n.dot(s.inside_sample(v)) - p.c, ho = p.n.dot(s.outside_sample(v)) - p.c;
-    if (ho > hi) return -hi / (ho - hi);
-    if (hi < 0) return INFINITY;
-    if (ho > 0) return -INFINITY;
-    return std::numeric_limits<double>::quiet_NaN();
+    return detail::leave(p, s.inside_sample(v), s.outside_sample(v));
   }
   // Where the plane normal . p = c crosses v's stick outwards (leaves_at's
   // crossing); NaN when it is not crossed outwards.

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "quadric.h"
+#include "stick_solid.h"
 #include "surface_graph.h"
 #include "voxpress/smooth/pressing.h"
 
@@ -101,7 +102,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     if (!fitted[v]) return;
     const bool lower_in = s.lower_inside(v);
     const Vec3 in = inside(v), out = outside(v);
-    const double own = quadric(v).exit(in, out, lower_in ? s.t[v] : 1 - s.t[v], o.margin, 1 - o.margin);
+    const double own = detail::stab(quadric(v), in, out, lower_in ? s.t[v] : 1 - s.t[v], o.margin);
     if (std::isnan(own)) {
       next[v] = -1;  // fitted, not crossed within the margins
       return;
@@ -110,7 +111,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     for (uint32_t k = off[v]; k < off[v + 1]; ++k) {
       const uint32_t w = adj[k];
       if (!fitted[w]) continue;
-      const double t = quadric(w).exit(in, out, own, o.margin, 1 - o.margin);
+      const double t = detail::stab(quadric(w), in, out, own, o.margin);
       if (std::isnan(t)) continue;
       sum += t;
       count += 1;

@@ -563,11 +563,19 @@ TEST(Cli, PressFindsFlatsAndWritesRegions) {
   EXPECT_EQ(test::read_file(tmp.path("nc.ply")), test::read_file(tmp.path("b.ply")));
   bool listed = false;
   const nlohmann::json nc = nlohmann::json::parse(std::ifstream(tmp.path("nc.json")));
-  for (const auto& p : nc["passes"])
+  for (const auto& p : nc["passes"]) {
     if (p["name"] == "curved-creases") {
       listed = true;
       EXPECT_FALSE(p["enabled"].get<bool>());
     }
+    // Every pass reports what it did: the detection's count is the flats'.
+    if (p["name"] == "flats") {
+      EXPECT_EQ(p["count"].get<size_t>(), nc["flats"]["count"].get<size_t>());
+    }
+    if (p["name"] == "free-ends") {
+      EXPECT_EQ(p["count"].get<size_t>(), nc["flats"]["barriers"].get<size_t>());
+    }
+  }
   EXPECT_TRUE(listed);
   EXPECT_EQ(
       run_cli("-q press " + tmp.path("b.nrrd") + " -o " + tmp.path("x.ply") + " --method cesn --disable-pass snap",

@@ -113,6 +113,12 @@ struct FlatStats {
   size_t crease_vertices = 0;  ///< vertices fit_creases placed (last round)
   size_t curved_crease_vertices = 0;  ///< vertices fit_curved_creases placed (last round)
   double seconds_creases = 0;  ///< all rounds of fit_creases and fit_curved_creases
+  /// The detection's passes (stab-refit, curved-test, merge, tangent-borders,
+  /// ring-off-plane, crease-refit, center-planes, rim-tangent): what each
+  /// changed in the last detection (cores refit, flats refused or merged,
+  /// borders judged smooth, junction planes, planes refit or centred, rim
+  /// vertices given back) and the seconds of those timed on their own.
+  PassTimes passes;
 };
 
 /// The segmentation of a stick surface into flats and the curved rest.
