@@ -4,7 +4,8 @@
 // stick leaves the solid it bounds.
 #pragma once
 
-#include <Eigen/QR>
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -31,80 +32,96 @@ struct Quadric {
     w = n.cross(u);
   }
 
-  // False with fewer than 12 points or a rank-deficient design (a curve).
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  Mat6 normal_matrix;  // the fit's normal equations (sum r r^T, sum z r), for stab
+  Vec6 normal_rhs;
+  double heights_squared = 0;  // sum z^2 of the fit's points
+
+  // The design row of p in this frame, and its height along n.
+  double row(const Vec3& p, Vec6& r) const {
+    const Vec3 d = p - m;
+    const double a = u.dot(d), b = w.dot(d);
+    r << a * a, a * b, b * b, a, b, 1;
+    return n.dot(d);
+  }
+
+  // Least squares by the 6x6 normal equations (a patch's heights are within
+  // a few cells of its PCA plane, so squaring the condition number costs
+  // nothing measurable: the same fits as a QR of the point rows to ~1e-13).
+  // False with fewer than 12 points or a rank-deficient design (a curve:
+  // an LDLT pivot below 1e-12 of the largest).
   bool fit(const std::vector<Vec3>& pts, const Vec3& outward) {
     if (pts.size() < 12) return false;
     const Pca p = pca(pts);
     set_frame(p.mean, p.normal.dot(outward) < 0 ? Vec3(-p.normal) : p.normal);
-    Eigen::MatrixXd A(pts.size(), 6);
-    Eigen::VectorXd z(pts.size());
-    for (size_t k = 0; k < pts.size(); ++k) {
-      const Vec3 d = pts[k] - m;
-      const double a = u.dot(d), b = w.dot(d);
-      A.row(Eigen::Index(k)) << a * a, a * b, b * b, a, b, 1;
-      z(Eigen::Index(k)) = n.dot(d);
+    normal_matrix.setZero();
+    normal_rhs.setZero();
+    heights_squared = 0;
+    Vec6 r;
+    for (const Vec3& x : pts) {
+      const double z = row(x, r);
+      normal_matrix.noalias() += r * r.transpose();
+      normal_rhs += z * r;
+      heights_squared += z * z;
     }
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-    if (qr.rank() < 6) return false;
-    q = qr.solve(z);
-    residual = std::sqrt((A * q - z).squaredNorm() / double(pts.size()));
+    const Eigen::LDLT<Mat6> ldlt(normal_matrix);
+    if (ldlt.info() != Eigen::Success) return false;
+    const Vec6 D = ldlt.vectorD().cwiseAbs();
+    if (!(D.minCoeff() > 1e-12 * D.maxCoeff())) return false;
+    q = ldlt.solve(normal_rhs);
+    residual = rms(pts.size());
     return true;
   }
 
-  // Refit (after fit) so that the surface also separates each stick's
-  // samples: ins[k] at least eps below it along n, outs[k] at least eps
-  // above. The pressed points near a rounded crease are biased (pressed
-  // in, then overshooting outwards for a few cells), and the sticks are
-  // not: each violated side joins the least squares as a target eps past
-  // its sample with `weight` (a squared-hinge penalty), once violated kept
-  // (so the active set only grows and the loop ends), at most `iters`
-  // solves. The residual is then the points' RMS distance to the refit.
+  // RMS distance along n of the fit's points to the surface, from the
+  // normal equations: sum (z - r.q)^2 = z.z - 2 q.(sum z r) + q.N q (the
+  // heights are within a few cells, so the cancellation costs ~3 of 16
+  // digits; the callers compare residuals at 0.02-0.1 cell).
+  double rms(size_t count) const {
+    const double ss = heights_squared - 2 * q.dot(normal_rhs) + q.dot(normal_matrix * q);
+    return std::sqrt(std::max(ss, 0.0) / double(count));
+  }
+
+  // Refit (after fit, on the same points) so that the surface also
+  // separates each stick's samples: ins[k] at least eps below it along n,
+  // outs[k] at least eps above. The pressed points near a rounded crease
+  // are biased (pressed in, then overshooting outwards for a few cells),
+  // and the sticks are not: each violated side joins the least squares as a
+  // target eps past its sample with `weight` (a squared-hinge penalty), once
+  // violated kept (so the active set only grows and the loop ends), at most
+  // `iters` solves. The residual is then the points' RMS distance to the
+  // refit.
   void stab(const std::vector<Vec3>& pts, const std::vector<Vec3>& ins, const std::vector<Vec3>& outs, double eps,
             double weight, int iters) {
-    auto row = [&](const Vec3& p, Eigen::Matrix<double, 6, 1>& r) {
-      const Vec3 d = p - m;
-      const double a = u.dot(d), b = w.dot(d);
-      r << a * a, a * b, b * b, a, b, 1;
-      return n.dot(d);
-    };
-    Eigen::Matrix<double, 6, 6> N0 = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> r0 = Eigen::Matrix<double, 6, 1>::Zero(), r;
-    for (const Vec3& p : pts) {
-      const double z = row(p, r);
-      N0 += r * r.transpose();
-      r0 += z * r;
-    }
-    // Each sample's design row and height, once (2k: inside, 2k + 1: outside).
-    std::vector<Eigen::Matrix<double, 6, 1>> rs(2 * ins.size());
-    std::vector<double> zs(2 * ins.size());
+    // Each sample's design row and target, once (2k: inside, 2k + 1: outside).
+    thread_local std::vector<Vec6> rs;
+    thread_local std::vector<double> zs;
+    thread_local std::vector<uint8_t> active;
+    rs.resize(2 * ins.size());
+    zs.resize(2 * ins.size());
+    active.assign(2 * ins.size(), 0);
     for (size_t k = 0; k < ins.size(); ++k) {
       zs[2 * k] = row(ins[k], rs[2 * k]);
       zs[2 * k + 1] = row(outs[k], rs[2 * k + 1]);
     }
-    std::vector<uint8_t> active(2 * ins.size(), 0);
+    Mat6 N = normal_matrix;
+    Vec6 rhs = normal_rhs;
     for (int it = 0; it < iters; ++it) {
       bool changed = false;
-      for (size_t k = 0; k < ins.size(); ++k) {
-        if (!active[2 * k] && zs[2 * k] - rs[2 * k].dot(q) > -eps) active[2 * k] = 1, changed = true;
-        if (!active[2 * k + 1] && zs[2 * k + 1] - rs[2 * k + 1].dot(q) < eps) active[2 * k + 1] = 1, changed = true;
+      for (size_t k = 0; k < 2 * ins.size(); ++k) {
+        if (active[k]) continue;
+        const double gap = zs[k] - rs[k].dot(q);  // the sample's height over the surface
+        if (k % 2 ? gap >= eps : gap <= -eps) continue;
+        active[k] = 1;
+        changed = true;
+        N.noalias() += weight * rs[k] * rs[k].transpose();
+        rhs += weight * (zs[k] + (k % 2 ? -eps : eps)) * rs[k];
       }
       if (!changed) break;
-      Eigen::Matrix<double, 6, 6> N = N0;
-      Eigen::Matrix<double, 6, 1> rhs = r0;
-      for (size_t k = 0; k < 2 * ins.size(); ++k) {
-        if (!active[k]) continue;
-        const double z = zs[k] + (k % 2 ? -eps : eps);
-        N += weight * rs[k] * rs[k].transpose();
-        rhs += weight * z * rs[k];
-      }
       q = N.ldlt().solve(rhs);
     }
-    double ss = 0;
-    for (const Vec3& p : pts) {
-      const double z = row(p, r);
-      ss += (z - r.dot(q)) * (z - r.dot(q));
-    }
-    residual = std::sqrt(ss / double(pts.size()));
+    residual = rms(pts.size());
   }
 
   // The surface point above (or below) p along n.
