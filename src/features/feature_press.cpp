@@ -47,7 +47,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   eo.tolerance = 0;
   eo.progress = nullptr;
   eo.free_ends = false;  // see PressOptions::free_ends
-  press(est, curves, eo);
+  const PressStats first_estimate = press(est, curves, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
   // piece of a face (a couple of degrees off) can change the second
@@ -66,7 +66,9 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
     return frozen;
   };
+  bool est_is_plain = true;  // est is still the plain press of s (no pass froze flats in it)
   for (int pass = 1; pass < detail::kDetectionPasses && !seg.flats.empty(); ++pass) {
+    est_is_plain = false;
     const auto t1 = std::chrono::steady_clock::now();
     est = s;
     apply_flats(est, seg);
@@ -90,7 +92,16 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const int rest = creases ? po.iterations / std::max(5, detail::kCreaseRounds + 1) : 0;
   PressOptions first = po;
   first.iterations = po.iterations - detail::kCreaseRounds * rest;
-  st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
+  // No flat: the final press would be the estimate again (same start, no
+  // frozen vertex, no barrier) when it runs the same schedule and the
+  // estimate never came within its tolerance (where it would have stopped).
+  if (seg.flats.empty() && est_is_plain && first.iterations == eo.iterations && press_levels(s, po.levels) == eo.levels &&
+      first_estimate.least_max_change >= po.tolerance) {
+    s.t = est.t;
+    st.press = first_estimate;
+  } else {
+    st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
+  }
   for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
     std::vector<uint8_t> fixed;
     const auto t2 = std::chrono::steady_clock::now();

@@ -278,14 +278,9 @@ namespace {
 // The shared iteration over vertices on sticks, t[i] in [0, 1], grouped in
 // curve families (a 3D plane family, or the one 2D family). Each vertex lies
 // on `per_vertex` curves (2 in 3D, 1 in 2D), so it has per_vertex proposal
-// slots; a family's curve-vertex k writes its proposal into slot dst[k].
-//
-// A family works in its plane's 2D index coordinates (u, v) with the plane's
-// metric: curve-vertex k (in ids order) sits at base[k] + t * e_mov[k], where
-// base is the stick's lower sample and mov which of u, v the stick runs
-// along. Only t is gathered per iteration; positions, arc lengths and the
-// bilaplacian are computed in 2D, and the displacement D = (du, dv) projects
-// onto the stick's physical line as dt = <D, e_mov>_g / <e_mov, e_mov>_g.
+// slots; a family's curve-vertex k writes its proposal into slot dst[k]
+// (layout: the top of this file). A displacement D = (du, dv) projects onto
+// the stick's physical line as dt = <D, e_mov>_g / <e_mov, e_mov>_g.
 struct Family {
   const std::vector<uint32_t>* ids;
   const std::vector<uint32_t>* offsets;
@@ -440,6 +435,7 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
         [](double x, double y) { return std::max(x, y); });
     st.iterations = it + 1;
     st.last_max_change = max_change;
+    st.least_max_change = it == 0 ? max_change : std::min(st.least_max_change, max_change);
     progress.add(1);
     if (max_change < o.tolerance) break;
   }
@@ -505,10 +501,13 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
       f.dst[k] = 2 * new_of[id] + uint32_t(slot_of(a, s.axis(id)));
     });
   }
-  const int levels = resolve_levels<3>(o.levels, n, [&](size_t i) { return s.lower_index(i); });
-  const PressStats st = iterate(t, families, 2, fz, br, o, levels);
+  const PressStats st = iterate(t, families, 2, fz, br, o, press_levels(s, o.levels));
   tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[old_of[i]] = t[i]; });
   return st;
+}
+
+int press_levels(const StickSurface& s, int requested) {
+  return resolve_levels<3>(requested, s.stick_count(), [&](size_t i) { return s.lower_index(i); });
 }
 
 PressStats press(StickSurface& surface, const PressOptions& options) {

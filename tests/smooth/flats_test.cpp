@@ -198,6 +198,27 @@ TEST(Flats, OrganicShapesHaveNoFlats) {
   }
 }
 
+TEST(Flats, WithoutFlatsTheResultIsThePlainPress) {
+  // No flat found: press_with_flats keeps its estimate when that was the
+  // very same press, else presses again; either way the bytes of press().
+  const GeneratedShape g = rotated(ShapeKind::sphere, 48, 2);
+  for (int levels : {0, 3}) {
+    SCOPED_TRACE("levels " + std::to_string(levels));
+    PressOptions po;
+    po.levels = levels;
+    StickSurface a = extract_sticks(g.volume), b = a;
+    const SliceCurves curves = build_slice_curves(a);
+    const FlatOptions fo;
+    FlatSegmentation seg;
+    const FeaturePressStats st = press_with_flats(a, curves, po, &fo, &seg);
+    ASSERT_TRUE(seg.flats.empty());
+    const PressStats plain = press(b, curves, po);
+    EXPECT_EQ(a.t, b.t);
+    EXPECT_EQ(st.press.iterations, plain.iterations);
+    EXPECT_EQ(st.press.levels, plain.levels);
+  }
+}
+
 // The Table 2 stages of the full pipeline on `s`: stick error of
 // "midpoint + tiles" and the evaluation of the final surface.
 struct Stages {

@@ -103,6 +103,7 @@ struct PressStats {
   int iterations = 0;              ///< iterations run
   int levels = 0;                  ///< coarse-to-fine stages used (PressOptions::levels resolved)
   double last_max_change = 0;      ///< largest |delta t| of the last iteration
+  double least_max_change = 0;     ///< the smallest of the iterations' largest |delta t|
   size_t curves = 0, fresh = 0, frozen = 0;
   double seconds = 0;
 };
@@ -118,6 +119,9 @@ PressStats press(StickSurface& surface, const SliceCurves& curves, const PressOp
 
 /// Convenience: builds the curves and presses.
 PressStats press(StickSurface& surface, const PressOptions& options = {});
+
+/// PressOptions::levels resolved for this surface (0: by its extent).
+int press_levels(const StickSurface& surface, int requested);
 
 /// Beyond the paper: a local quadric fit after pressing. The bilaplacian's
 /// fixed points are not circles, so tight curves stay pressed towards the
