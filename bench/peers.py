@@ -129,14 +129,15 @@ def main():
                     rows.setdefault((case, name), []).append(evaluate(a.cli, out, vol, tmp) + (seconds,))
     print(f"res {a.res}, seeds {a.seeds}: r->t RMS (vox) / mean normal error (deg) / labelled sharp edges / "
           "violations / seconds, means over the seeds (Slicer: its two filters; voxpress: the whole process)\n")
-    print("| case | " + " | ".join(m for m, _ in methods) + " |")
-    print("|---|" + "---|" * len(methods))
+    print("| case | " + " | ".join(m for m, _ in methods) + " | voxpress time / Slicer's |")
+    print("|---|" + "---|" * (len(methods) + 1))
     for case in dict.fromkeys(c for c, _ in rows):
-        cells = []
+        cells, seconds = [], []
         for name, _ in methods:
             m = np.mean(np.array(rows[(case, name)], dtype=float), axis=0)
             cells.append(f"{m[0]:.4f} / {m[1]:.2f}° / {m[2]:.0f} / {m[3]:.0f} / {m[4]:.2f} s")
-        print(f"| {case} | " + " | ".join(cells) + " |")
+            seconds.append(m[4])
+        print(f"| {case} | " + " | ".join(cells) + f" | {seconds[1] / seconds[0]:.0f}× |")
 
 
 if __name__ == "__main__":
