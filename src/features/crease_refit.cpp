@@ -48,7 +48,7 @@ constexpr double kRefitClear = 0.1;    // cells
 constexpr double kRefitTurn = 1;       // degrees
 constexpr int kRefitRounds = 3;
 bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg, std::vector<Plane>& planes,
-                  std::vector<uint8_t>& moved, PassTimes& passes) {
+                  std::vector<uint8_t>& moved) {
   const size_t n = S.x.size(), F = planes.size();
   moved.assign(F, 0);
   if (F < 2) return false;
@@ -151,7 +151,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       planes[f] = P;
       moved[f] = 1;
       again = true;
-      ++passes.count[size_t(broken[f] ? Pass::crease_refit : Pass::center_planes)];
+      ++seg.stats.passes.count[size_t(broken[f] ? Pass::crease_refit : Pass::center_planes)];
       // The members it no longer stabs with the margin leave (the extension
       // may give them to a neighbour; Pressing places them).
       std::vector<uint32_t> kept;

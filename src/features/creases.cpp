@@ -238,7 +238,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
   std::vector<uint32_t> chain;
   RingScratch rs;
   for (const auto& f : found) {
-    if (std::isnan(f.t)) continue;
+    if (std::isnan(f.t) || !c.network) continue;
     rings_around(f.v, c.rings, off, adj, [](uint32_t) { return true; }, rs);
     if (std::any_of(rs.out.begin(), rs.out.end(),
                     [&](const auto& wd) { return role[wd.first] != kCreaseFree && region[wd.first] < 0; })) {

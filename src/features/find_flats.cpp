@@ -429,7 +429,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     stale = false;
     // Beyond the paper: the planes also keep their creases' samples on the right side.
     const auto t_refit = std::chrono::steady_clock::now();
-    const bool refit = o.passes.on(Pass::crease_refit) && crease_refit(S, o, seg, planes, refitted, seg.stats.passes);
+    const bool refit = o.passes.on(Pass::crease_refit) && crease_refit(S, o, seg, planes, refitted);
     seg.stats.passes.seconds[size_t(Pass::crease_refit)] += seconds_since(t_refit);
     if (refit) {
       for (size_t f = 0; f < planes.size(); ++f)

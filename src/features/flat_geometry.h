@@ -38,9 +38,10 @@ constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 // min_area voters; the flat itself must still reach min_area after growth
 // (accept). Voters are the vertices whose estimated normal lies within the
 // cone of the cell's direction, so a face whose estimate its rounded edges
-// bend has far fewer voters than sticks: fandisk 128's two 600-cell side
-// faces had 46 in their best cell and were never tried with a share of 1
-// (docs/ARCHITECTURE.md at d97b886, Flats: Greedy extraction).
+// bend has far fewer voters than sticks: a face of several hundred cells
+// between rounded edges can have only a few dozen in its best cell, and a
+// share of 1 never tries it (docs/ARCHITECTURE.md at d97b886, Flats:
+// Greedy extraction).
 constexpr double kSeedShare = 0.3;
 // The curvature test (Detector::curved, FlatOptions::curved_gain): a flat's
 // neighbourhood is its core grown kCurvedRings rings over the vertices whose
@@ -227,6 +228,6 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t);
 
 // The crease refit (crease_refit.cpp).
 bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg, std::vector<Plane>& planes,
-                  std::vector<uint8_t>& moved, PassTimes& passes);
+                  std::vector<uint8_t>& moved);
 
 }  // namespace voxpress::flats_impl

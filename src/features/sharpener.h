@@ -295,7 +295,7 @@ struct Sharpener {
       // plane (a face through a sample) must not hide the crossing.
       double at, miss_f;
       if (h1 > h0) {
-        at = detail::leave(Plane{seg.flats[size_t(f)].index_normal, seg.flats[size_t(f)].index_offset}, I, O);
+        at = detail::leave_heights(h0, h1);
         miss_f = at < 0 ? h0 : at > 1 ? -h1 : 0;
       } else if (h0 >= 0) {
         at = -h0, miss_f = h0;

@@ -20,12 +20,16 @@ namespace voxpress::detail {
 // runs outwards through the plane; +inf when the whole line lies below a
 // plane it does not climb (it never leaves), -inf when it lies wholly above
 // one (it is never in); NaN when it enters the half-space on its way out.
-inline double leave(const Plane& P, const Vec3& in, const Vec3& out) {
-  const double hi = P.n.dot(in) - P.c, ho = P.n.dot(out) - P.c;
+// `leave_heights` takes the two samples' heights over the plane when the
+// caller has them.
+inline double leave_heights(double hi, double ho) {
   if (ho > hi) return -hi / (ho - hi);
   if (hi < 0) return INFINITY;
   if (ho > 0) return -INFINITY;
   return std::numeric_limits<double>::quiet_NaN();
+}
+inline double leave(const Plane& P, const Vec3& in, const Vec3& out) {
+  return leave_heights(P.n.dot(in) - P.c, P.n.dot(out) - P.c);
 }
 
 // The same for a quadric: the exit nearest `near` within the stick's
