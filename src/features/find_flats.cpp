@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -51,49 +52,15 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   const Surface S = make_surface(s, estimate);
   const double cone = detail::kFlatCone * kPi / 180, cos_cone = std::cos(cone);
 
-  // ---- Votes (Section 3): only vertices whose normal agrees with every
-  // neighbour's within the cone (curved regions then vote little).
-  std::vector<uint64_t> keys(n * kMaxVotes);
-  std::vector<uint8_t> count(n, 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v < r.end(); ++v) {
-      bool planar = true;
-      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && planar; ++k)
-        planar = S.nrm[v].dot(S.nrm[S.adj[k]]) >= cos_cone;
-      if (planar) count[v] = uint8_t(votes_of(S.nrm[v], S.x[v], cone, &keys[v * kMaxVotes]));
-    }
-  });
-  std::vector<uint64_t> offsets(n + 1, 0);
-  for (size_t v = 0; v < n; ++v) offsets[v + 1] = offsets[v] + count[v];
-  seg.stats.votes = offsets[n];
-  // (key, voter) pairs sorted: runs are accumulator cells with their voters.
-  struct Vote {
-    uint64_t key;
-    uint32_t voter;
-    bool operator<(const Vote& b) const { return key < b.key || (key == b.key && voter < b.voter); }
-  };
-  std::vector<Vote> votes(offsets[n]);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
-    for (uint32_t q = 0; q < count[v]; ++q) votes[offsets[v] + q] = {keys[v * kMaxVotes + q], uint32_t(v)};
-  });
-  for (size_t v = 0; v < n; ++v) seg.stats.voters += count[v] > 0;
-  tbb::parallel_sort(votes.begin(), votes.end());
-  std::vector<uint64_t> cell_key;
-  std::vector<uint32_t> cell_begin, cell_count;
-  for (size_t i = 0; i < votes.size(); ++i)
-    if (i == 0 || votes[i].key != votes[i - 1].key) {
-      cell_key.push_back(votes[i].key);
-      cell_begin.push_back(uint32_t(i));
-      cell_count.push_back(0);
-      ++cell_count.back();
-    } else {
-      ++cell_count.back();
-    }
-  cell_begin.push_back(uint32_t(votes.size()));
-  seg.stats.cells = cell_key.size();
-  auto cell_of = [&](uint64_t key) {
-    return size_t(std::lower_bound(cell_key.begin(), cell_key.end(), key) - cell_key.begin());
-  };
+  // ---- Votes (Section 3).
+  Votes V = cast_votes(S, cone);
+  seg.stats.votes = V.votes;
+  seg.stats.voters = V.voters;
+  seg.stats.cells = V.cell_key.size();
+  const auto& cell_key = V.cell_key;
+  const auto& cell_begin = V.cell_begin;
+  auto& cell_count = V.cell_count;
+  auto& count = V.count;
 
   // ---- Greedy extraction, best cell first (lazy max-heap; ties by cell index).
   std::priority_queue<std::pair<uint32_t, int64_t>> heap;
@@ -122,11 +89,76 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   std::vector<uint32_t> seeds;
   auto unvote = [&](uint32_t v) {  // drops the stick's votes from the accumulator
     for (uint32_t q = 0; q < count[v]; ++q) {
-      const uint64_t key = keys[v * kMaxVotes + q];
-      const size_t cc = cell_of(key);
-      if (cell_key[cc] == key && cell_count[cc] > 0) --cell_count[cc];
+      const uint32_t cc = V.vote_cell[v * kMaxVotes + q];
+      if (cell_count[cc] > 0) --cell_count[cc];
     }
     count[v] = 0;
+  };
+  // The greedy loop is serial by definition (each flat takes its sticks
+  // from the later cells' seeds), but a try reads only the regions, which
+  // change only when a try is accepted, so the next cells the heap would
+  // pop are tried ahead, in parallel, each by its own detector (a sphere
+  // rejects ~1,700 cells at 256^3, a CAD part accepts 8 of ~180). A result
+  // is used only when no flat was accepted since it was computed; the
+  // order of the loop, and so the output, are those of the serial loop.
+  // Tries after an accepted flat are mostly wasted (often the same face
+  // from a neighbouring cell), so the look-ahead starts at one cell after
+  // each acceptance and doubles with each rejection.
+  struct Try {
+    size_t cell = 0;
+    Plane P;
+    std::vector<uint32_t> members, rejected;
+    size_t rim_begin = 0, restabbed = 0, refused_curved = 0;
+  };
+  const size_t threads = size_t(tbb::this_task_arena::max_concurrency());
+  std::vector<Try> tries;
+  size_t accepted = 0, tries_version = SIZE_MAX, streak = 0;  // streak: rejections since the last acceptance
+  tbb::enumerable_thread_specific<Detector> detectors([&] {
+    return Detector{S, o, seg.region, std::vector<uint32_t>(n, 0), 0, cos_cone, std::vector<uint8_t>(n, 0)};
+  });
+  // The cells the loop would try after `first` if no flat were accepted.
+  auto next_cells = [&](size_t first) {
+    std::vector<size_t> cells{first};
+    // Up to 4 per thread: enough to keep every thread busy.
+    const size_t batch = threads == 1 ? 1 : std::min(4 * threads, size_t(1) << std::min<size_t>(streak, 10));
+    if (batch == 1) return cells;
+    auto h = heap;
+    while (!h.empty() && cells.size() < batch) {
+      const auto [cnt, neg] = h.top();
+      h.pop();
+      const size_t c = size_t(-neg);
+      if (std::find(cells.begin(), cells.end(), c) != cells.end()) continue;
+      if (cnt != cell_count[c]) {
+        if (cell_count[c] > 0) h.push({cell_count[c], neg});
+        continue;
+      }
+      if (double(cnt) < kSeedShare * o.min_area) break;
+      cells.push_back(c);
+    }
+    return cells;
+  };
+  auto result_of = [&](size_t c) -> const Try& {
+    if (tries_version == accepted)
+      for (const Try& t : tries)
+        if (t.cell == c) return t;
+    const std::vector<size_t> cells = next_cells(c);
+    tries.assign(cells.size(), Try{});
+    tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
+      Try& t = tries[k];
+      t.cell = cells[k];
+      std::vector<uint32_t> own;
+      for (uint32_t i = cell_begin[t.cell]; i < cell_begin[t.cell + 1]; ++i)
+        if (seg.region[V.voter[i]] < 0) own.push_back(V.voter[i]);
+      if (double(own.size()) < kSeedShare * o.min_area) return;  // the loop skips it
+      Detector& d = detectors.local();
+      const size_t restabbed = d.restabbed, refused = d.refused_curved;
+      t.members = d.cluster_from(own, t.P, t.rejected);
+      t.rim_begin = d.rim_begin;
+      t.restabbed = d.restabbed - restabbed;
+      t.refused_curved = d.refused_curved - refused;
+    });
+    tries_version = accepted;
+    return tries.front();
   };
   while (!heap.empty()) {
     const auto [cnt, neg] = heap.top();
@@ -141,24 +173,33 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     ++seg.stats.tried;
     seeds.clear();
     for (uint32_t i = cell_begin[c]; i < cell_begin[c + 1]; ++i)
-      if (seg.region[votes[i].voter] < 0) seeds.push_back(votes[i].voter);
+      if (seg.region[V.voter[i]] < 0) seeds.push_back(V.voter[i]);
     cell_count[c] = 0;  // used: accepted or not, this cell is done
     if (double(seeds.size()) < kSeedShare * o.min_area) continue;
-    Plane P;
-    std::vector<uint32_t> rejected;
-    const std::vector<uint32_t> members = det.cluster_from(seeds, P, rejected);
+    const Try& tr = result_of(c);
+    const Plane& P = tr.P;
+    const std::vector<uint32_t>& rejected = tr.rejected;
+    const std::vector<uint32_t>& members = tr.members;
+    det.restabbed += tr.restabbed;
+    det.refused_curved += tr.refused_curved;
     // A rejected core's vertices stop voting (they may still join a flat
     // grown from elsewhere): without this a cylinder's wall is tried once per
     // direction cell along its circle of normals.
     for (uint32_t v : rejected) unvote(v);
-    if (members.empty()) continue;
+    if (members.empty()) {
+      ++streak;
+      continue;
+    }
+    streak = 0;
     const int32_t id = int32_t(seg.flats.size());
+    for (size_t i = tr.rim_begin; i < members.size(); ++i) det.rim[members[i]] = 1;
     for (uint32_t v : members) {
       seg.region[v] = id;
       seg.t[v] = frozen_t(v, P);
       unvote(v);
     }
     seg.flats.push_back(flat_of(P));
+    ++accepted;  // the region changed: the batch's other results are stale
     progress.add(1);
   }
   // ---- Merge (beyond the paper): the greedy growth can take one face as

@@ -24,6 +24,7 @@ struct Detector {
 
   double cos_cone;
   std::vector<uint8_t> rim;  // per vertex: added by a rim growth (not a core member)
+  size_t rim_begin = 0;      // where the last rim growth's vertices start in its cluster
   size_t restabbed = 0, refused_curved = 0;  // cores the stab refit changed, flats the curved test refused
   // A core vertex: its stick stabbed, its estimated vertex within tol of the
   // plane and its estimated normal within the cone of the plane's.
@@ -59,7 +60,7 @@ struct Detector {
 
   // The rim: the stabbed sticks within rim_rings of `cluster`, flagged.
   void grow_rim(std::vector<uint32_t>& cluster, const Plane& P) {
-    const size_t before = cluster.size();
+    const size_t before = rim_begin = cluster.size();
     grow(cluster, 0, detail::kRimRings, [&](uint32_t w) { return !std::isnan(crossing(S, w, P, o.margin)); });
     for (size_t i = before; i < cluster.size(); ++i) rim[cluster[i]] = 1;
   }

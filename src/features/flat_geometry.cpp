@@ -41,15 +41,22 @@ uint32_t direction_cell(const Vec3& d) {
 }
 
 Vec3 cell_direction(uint32_t c) {
-  const int i = int(c % kCube), j = int(c / kCube % kCube), face = int(c / (kCube * kCube));
-  const int a = face / 2;
-  const double sign = face % 2 ? -1 : 1;
-  auto coord = [](int k) { return std::tan(((k + 0.5) * 2.0 / kCube - 1) * kPi / 4); };
-  Vec3 d;
-  d[a] = sign;
-  d[(a + 1) % 3] = coord(i);
-  d[(a + 2) % 3] = coord(j);
-  return d.normalized();
+  // Every cell's direction, computed once (each vertex looks up seven).
+  static const std::vector<Vec3> table = [] {
+    std::vector<Vec3> t(6 * kCube * kCube);
+    auto coord = [](int k) { return std::tan(((k + 0.5) * 2.0 / kCube - 1) * kPi / 4); };
+    for (uint32_t q = 0; q < t.size(); ++q) {
+      const int i = int(q % kCube), j = int(q / kCube % kCube), face = int(q / (kCube * kCube));
+      const int a = face / 2;
+      Vec3 d;
+      d[a] = face % 2 ? -1 : 1;
+      d[(a + 1) % 3] = coord(i);
+      d[(a + 2) % 3] = coord(j);
+      t[q] = d.normalized();
+    }
+    return t;
+  }();
+  return table[c];
 }
 
 // Unit vectors spanning the plane orthogonal to unit n.
@@ -65,10 +72,15 @@ int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out) {
   Vec3 u, v;
   frame(n, u, v);
   const double r = std::tan(0.7 * cone);
+  static const auto ring = [] {  // cos and sin of the six directions' angles
+    std::array<std::array<double, 2>, kMaxVotes> cs{};
+    for (int k = 1; k < kMaxVotes; ++k) cs[size_t(k)] = {std::cos(k * kPi / 3), std::sin(k * kPi / 3)};
+    return cs;
+  }();
   int count = 0;
   for (int k = 0; k < kMaxVotes; ++k) {
-    const double ang = k * kPi / 3;
-    const Vec3 d = k == 0 ? n : Vec3((n + r * (std::cos(ang) * u + std::sin(ang) * v)).normalized());
+    const auto& [c_k, s_k] = ring[size_t(k)];
+    const Vec3 d = k == 0 ? n : Vec3((n + r * (c_k * u + s_k * v)).normalized());
     const uint32_t c = direction_cell(d);
     const double off = cell_direction(c).dot(x);
     const uint64_t key = (uint64_t(c) << 32) | uint32_t(int64_t(std::floor(off)) + (int64_t(1) << 30));
@@ -79,6 +91,71 @@ int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out) {
   return count;
 }
 
+// ---------------------------------------------------------------- votes
+Votes cast_votes(const Surface& S, double cone) {
+  const size_t n = S.x.size();
+  const double cos_cone = std::cos(cone);
+  Votes V;
+  // Only vertices whose normal agrees with every neighbour's within the
+  // cone vote (curved regions then vote little).
+  std::vector<uint64_t> keys(n * kMaxVotes);
+  V.count.assign(n, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v < r.end(); ++v) {
+      bool planar = true;
+      for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && planar; ++k)
+        planar = S.nrm[v].dot(S.nrm[S.adj[k]]) >= cos_cone;
+      if (planar) V.count[v] = uint8_t(votes_of(S.nrm[v], S.x[v], cone, &keys[v * kMaxVotes]));
+    }
+  });
+  // The (key, voter) pairs in the order of a sort by key then voter: a
+  // counting sort by direction cell (each bucket keeps the voters in
+  // order), then each bucket sorted by offset bin, (bin, voter) packed in
+  // one word. Runs of one key are the accumulator's cells.
+  constexpr size_t kDirections = 6 * kCube * kCube;
+  std::vector<uint64_t> bucket(kDirections + 1, 0);
+  for (size_t v = 0; v < n; ++v) {
+    V.voters += V.count[v] > 0;
+    for (uint32_t q = 0; q < V.count[v]; ++q) ++bucket[(keys[v * kMaxVotes + q] >> 32) + 1];
+  }
+  for (size_t c = 0; c < kDirections; ++c) bucket[c + 1] += bucket[c];
+  V.votes = bucket[kDirections];
+  std::vector<uint64_t> sorted(V.votes);  // offset bin << 32 | voter
+  {
+    std::vector<uint64_t> at(bucket.begin(), bucket.end() - 1);
+    for (size_t v = 0; v < n; ++v)
+      for (uint32_t q = 0; q < V.count[v]; ++q) {
+        const uint64_t key = keys[v * kMaxVotes + q];
+        sorted[at[key >> 32]++] = (key << 32) | v;
+      }
+  }
+  tbb::parallel_for(size_t(0), kDirections, [&](size_t c) {
+    std::sort(sorted.begin() + ptrdiff_t(bucket[c]), sorted.begin() + ptrdiff_t(bucket[c + 1]));
+  });
+  V.voter.resize(V.votes);
+  for (size_t d = 0; d < kDirections; ++d)
+    for (uint64_t i = bucket[d]; i < bucket[d + 1]; ++i) {
+      V.voter[i] = uint32_t(sorted[i]);
+      const uint64_t key = (uint64_t(d) << 32) | (sorted[i] >> 32);
+      if (i == bucket[d] || key != V.cell_key.back()) {
+        V.cell_key.push_back(key);
+        V.cell_begin.push_back(uint32_t(i));
+        V.cell_count.push_back(0);
+      }
+      ++V.cell_count.back();
+    }
+  V.cell_begin.push_back(uint32_t(V.votes));
+  // Each vote's cell, by the voter's vote slot (unvoting's look-up).
+  V.vote_cell.assign(n * kMaxVotes, 0);
+  tbb::parallel_for(size_t(0), V.cell_key.size(), [&](size_t c) {
+    for (uint32_t i = V.cell_begin[c]; i < V.cell_begin[c + 1]; ++i) {
+      const uint32_t v = V.voter[i];
+      for (uint32_t q = 0; q < V.count[v]; ++q)
+        if (keys[v * kMaxVotes + q] == V.cell_key[c]) V.vote_cell[v * kMaxVotes + q] = uint32_t(c);
+    }
+  });
+  return V;
+}
 
 double crossing(const Surface& S, size_t v, const Plane& P, double margin) {
   return detail::stab(P, S.inside(v), S.outside(v), margin);

@@ -123,6 +123,20 @@ struct Surface {
   Vec3 outside(size_t v) const { return s->outside_sample(v); }
 };
 
+// The accumulator (Section 3): each vertex's votes, grouped in cells (a
+// direction cell and an offset bin), cells in key order, each cell's voters
+// in vertex order.
+struct Votes {
+  std::vector<uint8_t> count;       // per vertex: its votes still counted (0: not voting)
+  std::vector<uint32_t> vote_cell;  // per vertex and vote slot (kMaxVotes each): the cell
+  std::vector<uint64_t> cell_key;   // per cell: direction cell << 32 | offset bin
+  std::vector<uint32_t> cell_begin; // per cell: its voters are voter[cell_begin[c] .. cell_begin[c + 1])
+  std::vector<uint32_t> cell_count; // per cell: its voters still counted
+  std::vector<uint32_t> voter;
+  size_t votes = 0, voters = 0;
+};
+Votes cast_votes(const Surface& S, double cone);
+
 // t (from the inside sample) where the plane crosses stick v, or NaN when it
 // does not cross it with the margin.
 
