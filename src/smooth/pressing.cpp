@@ -386,7 +386,17 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
             const double tk = t[ids[k]], mv = double(fam.mov[k]);
             w.pos[i] = Vec2(fam.base[k].x() + (1 - mv) * tk, fam.base[k].y() + mv * tk);
           };
+          // A curve, or a piece, whose vertices are all frozen proposes
+          // nothing anyone reads (on a CAD part most of the vertices are
+          // frozen flats, cut off by their barriers): skipped.
+          const auto any_free = [&](uint32_t from, uint32_t count) {
+            if (frozen.empty()) return true;
+            for (uint32_t i = 0; i < count; ++i)
+              if (!frozen[ids[b + (from + i) % m]]) return true;
+            return false;
+          };
           if (first_barrier == m) {
+            if (!any_free(0, m)) continue;
             w.resize(m);
             for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
             curve_step(m, true, d, s2, o.resample, weighted, correction, g, w);
@@ -397,6 +407,10 @@ PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, 
           for (uint32_t k = 0; k < m;) {
             uint32_t len = 1;
             while (!barrier[ids[b + (first_barrier + k + len) % m]]) ++len;
+            if (!any_free(first_barrier + k + 1, len - 1)) {
+              k += len;
+              continue;
+            }
             // Free ends: the piece without its two barriers (PressOptions::free_ends).
             const bool loose = o.free_ends && len >= kFreePiece;
             const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
