@@ -86,6 +86,14 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     if (!(t >= 0 && t <= 1)) throw std::logic_error("find_flats: a flat's plane does not cross one of its sticks");
     return std::clamp(t, o.margin, 1 - o.margin);
   };
+  // The voters of cell c not in a flat yet, into `out`: whether they are
+  // enough to seed a cluster (kSeedShare).
+  auto seeds_of = [&](size_t c, std::vector<uint32_t>& out) {
+    out.clear();
+    for (uint32_t i = cell_begin[c]; i < cell_begin[c + 1]; ++i)
+      if (seg.region[V.voter[i]] < 0) out.push_back(V.voter[i]);
+    return double(out.size()) >= kSeedShare * o.min_area;
+  };
   std::vector<uint32_t> seeds;
   auto unvote = [&](uint32_t v) {  // drops the stick's votes from the accumulator
     for (uint32_t q = 0; q < count[v]; ++q) {
@@ -147,9 +155,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
       Try& t = tries[k];
       t.cell = cells[k];
       std::vector<uint32_t> own;
-      for (uint32_t i = cell_begin[t.cell]; i < cell_begin[t.cell + 1]; ++i)
-        if (seg.region[V.voter[i]] < 0) own.push_back(V.voter[i]);
-      if (double(own.size()) < kSeedShare * o.min_area) return;  // the loop skips it
+      if (!seeds_of(t.cell, own)) return;  // the loop skips it
       Detector& d = detectors.local();
       const size_t restabbed = d.restabbed, refused = d.refused_curved;
       t.members = d.cluster_from(own, t.P, t.rejected);
@@ -171,11 +177,8 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
     // Too few voters to seed a cluster: nothing left can (kSeedShare).
     if (double(cnt) < kSeedShare * o.min_area) break;
     ++seg.stats.tried;
-    seeds.clear();
-    for (uint32_t i = cell_begin[c]; i < cell_begin[c + 1]; ++i)
-      if (seg.region[V.voter[i]] < 0) seeds.push_back(V.voter[i]);
     cell_count[c] = 0;  // used: accepted or not, this cell is done
-    if (double(seeds.size()) < kSeedShare * o.min_area) continue;
+    if (!seeds_of(c, seeds)) continue;
     const Try& tr = result_of(c);
     const Plane& P = tr.P;
     const std::vector<uint32_t>& rejected = tr.rejected;
