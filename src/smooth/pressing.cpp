@@ -31,9 +31,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "core/sentinel.h"
 #include "core/timing.h"
-#include "voxpress/extract/cube_cases.h"
 
 namespace voxpress {
 
@@ -41,16 +39,12 @@ using detail::seconds_since;
 
 namespace {
 
-using detail::kNone;
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
 // PressOptions::free_ends: pieces from barrier to barrier of at least this
 // many segments (7 vertices between the barriers) get free ends. Measured
 // 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
 // holes of plate_holes at 128^3 (docs/ARCHITECTURE.md at d97b886).
 constexpr uint32_t kFreePiece = 8;
-
-// Slot of plane family a among the two families of a stick along axis b.
-inline int slot_of(int a, int b) { return a < 3 - a - b ? 0 : 1; }
 
 // A location on a polyline: point k + f (point k + 1 - point k); past a
 // free end (PressOptions::free_ends), that location reflected through the
@@ -210,68 +204,6 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
 }
 
 }  // namespace
-
-SliceCurves build_slice_curves(const StickSurface& s) {
-  const size_t n = s.stick_count();
-  std::vector<std::array<int64_t, 3>> lo(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) { lo[i] = s.lower_index(i); });
-  // Two neighbours per stick and plane slot.
-  std::vector<uint32_t> nb(4 * n, kNone);
-  auto link = [&](uint32_t u, uint32_t v, int slot) {
-    uint32_t* x = &nb[4 * size_t(u) + 2 * size_t(slot)];
-    if (x[0] == v || x[1] == v) return;
-    if (x[0] == kNone)
-      x[0] = v;
-    else if (x[1] == kNone)
-      x[1] = v;
-    else
-      throw std::logic_error("slice curves: a stick has more than two neighbours in a plane");
-  };
-  for (const Triangle& t : s.triangles)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t u = t[size_t(e)], v = t[size_t((e + 1) % 3)];
-      const int au = s.axis(u), av = s.axis(v);
-      for (int a = 0; a < 3; ++a)
-        if (a != au && a != av && lo[u][size_t(a)] == lo[v][size_t(a)]) {
-          link(u, v, slot_of(a, au));
-          link(v, u, slot_of(a, av));
-          break;
-        }
-    }
-  SliceCurves c;
-  for (int a = 0; a < 3; ++a) {
-    std::vector<uint8_t> seen(n, 0);
-    struct Curve {
-      int64_t plane;
-      uint32_t begin, size;
-    };
-    std::vector<Curve> curves;
-    std::vector<uint32_t> ids;
-    for (uint32_t s0 = 0; s0 < n; ++s0) {
-      if (s.axis(s0) == a || seen[s0]) continue;
-      const uint32_t begin = uint32_t(ids.size());
-      uint32_t prev = kNone, cur = s0;
-      do {
-        seen[cur] = 1;
-        ids.push_back(cur);
-        const uint32_t* x = &nb[4 * size_t(cur) + 2 * size_t(slot_of(a, s.axis(cur)))];
-        if (x[0] == kNone || x[1] == kNone)
-          throw std::logic_error("slice curves: a stick lacks a neighbour in a plane (open cut)");
-        const uint32_t next = x[0] != prev ? x[0] : x[1];
-        prev = cur;
-        cur = next;
-      } while (cur != s0);
-      curves.push_back({lo[s0][size_t(a)], begin, uint32_t(ids.size()) - begin});
-    }
-    std::stable_sort(curves.begin(), curves.end(), [](const Curve& x, const Curve& y) { return x.plane < y.plane; });
-    c.offsets[a].push_back(0);
-    for (const Curve& cv : curves) {
-      c.ids[a].insert(c.ids[a].end(), ids.begin() + cv.begin, ids.begin() + cv.begin + cv.size);
-      c.offsets[a].push_back(uint32_t(c.ids[a].size()));
-    }
-  }
-  return c;
-}
 
 namespace {
 
@@ -512,7 +444,7 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
       ids[a][k] = new_of[id];
       f.base[k] = Vec2(double(l[size_t(u)]), double(l[size_t(v)]));
       f.mov[k] = uint8_t(s.axis(id) == u ? 0 : 1);
-      f.dst[k] = 2 * new_of[id] + uint32_t(slot_of(a, s.axis(id)));
+      f.dst[k] = 2 * new_of[id] + uint32_t(SliceCurves::slot(a, s.axis(id)));
     });
   }
   const PressStats st = iterate(t, families, 2, fz, br, o, press_levels(s, o.levels));
@@ -529,69 +461,6 @@ PressStats press(StickSurface& surface, const PressOptions& options) {
 }
 
 // --------------------------------------------------------------------- 2D
-std::array<double, 2> Contours2D::position(size_t v) const {
-  std::array<double, 2> p{double(lower[v][0]), double(lower[v][1])};
-  p[axis[v]] += t[v];
-  return p;
-}
-
-Contours2D extract_contours(int64_t w, int64_t h, std::vector<uint8_t> inside) {
-  if (w < 1 || h < 1 || inside.size() != size_t(w * h)) throw std::invalid_argument("extract_contours: bad image");
-  Contours2D c;
-  c.width = w;
-  c.height = h;
-  c.inside = std::move(inside);
-  auto at = [&](int64_t x, int64_t y) { return x >= 0 && y >= 0 && x < w && y < h && c.inside[size_t(y * w + x)]; };
-  // Stick ids: x-sticks (x, y)-(x+1, y) for x in [-1, w-1], y in [0, h-1];
-  // y-sticks (x, y)-(x, y+1) for x in [0, w-1], y in [-1, h-1].
-  std::vector<uint32_t> xid(size_t((w + 1) * h), kNone), yid(size_t(w * (h + 1)), kNone);
-  for (int64_t y = -1; y <= h; ++y)
-    for (int64_t x = -1; x <= w; ++x) {
-      if (y >= 0 && y < h && x < w && at(x, y) != at(x + 1, y)) {
-        xid[size_t(y * (w + 1) + x + 1)] = uint32_t(c.lower.size());
-        c.lower.push_back({x, y});
-        c.axis.push_back(0);
-      }
-      if (x >= 0 && x < w && y < h && at(x, y) != at(x, y + 1)) {
-        yid[size_t((y + 1) * w + x)] = uint32_t(c.lower.size());
-        c.lower.push_back({x, y});
-        c.axis.push_back(1);
-      }
-    }
-  c.t.assign(c.lower.size(), 0.5);
-  std::vector<uint32_t> next(c.lower.size(), kNone);
-  for (int64_t y = -1; y < h; ++y)
-    for (int64_t x = -1; x < w; ++x) {
-      const bool q[4] = {at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)};
-      unsigned mask = 0;
-      for (int k = 0; k < 4; ++k) mask |= unsigned(q[k]) << k;
-      const SquareCase& sc = square_case(mask);
-      auto edge = [&](int e) -> uint32_t {  // square edge e joins corners e and e + 1
-        switch (e) {
-          case 0: return xid[size_t(y * (w + 1) + x + 1)];
-          case 1: return yid[size_t((y + 1) * w + x + 1)];
-          case 2: return xid[size_t((y + 1) * (w + 1) + x + 1)];
-          default: return yid[size_t((y + 1) * w + x)];
-        }
-      };
-      for (int k = 0; k < sc.count; ++k) next[edge(sc.segments[size_t(k)][0])] = edge(sc.segments[size_t(k)][1]);
-    }
-  std::vector<uint8_t> seen(c.lower.size(), 0);
-  c.offsets.push_back(0);
-  for (uint32_t v0 = 0; v0 < c.lower.size(); ++v0) {
-    if (seen[v0]) continue;
-    uint32_t v = v0;
-    do {
-      if (v == kNone) throw std::logic_error("extract_contours: open contour");
-      seen[v] = 1;
-      c.ids.push_back(v);
-      v = next[v];
-    } while (v != v0);
-    c.offsets.push_back(uint32_t(c.ids.size()));
-  }
-  return c;
-}
-
 PressStats press(Contours2D& c, const PressOptions& o) {
   std::vector<Family> families(1);
   Family& f = families[0];

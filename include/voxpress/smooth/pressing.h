@@ -37,6 +37,9 @@ struct SliceCurves {
   std::vector<uint32_t> ids[3];
   std::vector<uint32_t> offsets[3];
   size_t curve_count() const { return offsets[0].size() + offsets[1].size() + offsets[2].size() - 3; }
+  /// Which of the two curves of a stick along axis `axis` the curve of
+  /// family `a` is: 0 for the lower of its two families, 1 for the other.
+  static int slot(int a, int axis) { return a < 3 - a - axis ? 0 : 1; }
 };
 
 /// Builds the slice curves from the surface's triangles (a triangle edge whose
