@@ -1,4 +1,5 @@
 // voxpress info FILE: lattice, voxel type, labels with counts, sticks.
+#include <cmath>
 #include <cstdio>
 
 #include "common.h"
@@ -61,6 +62,23 @@ void run_info(const InfoCmd& c, const Global& g) {
       }
       labels.push_back(e);
       std::printf("  %-12s %14lu %12s\n", fmt(value).c_str(), (unsigned long)n, sticks.c_str());
+    }
+    // Which labels touch (lattice edges between them), for label maps.
+    bool integers = true;
+    for (auto& [value, n] : *hist) integers = integers && value == std::floor(value);
+    if (v.components == 1 && nonzero > 1 && integers) {
+      const LabelTable table = label_table(v);
+      nlohmann::json contacts = nlohmann::json::array();
+      size_t between = 0;
+      for (const LabelContact& t : table.contacts) between += t.a != 0;
+      std::printf("contacts    %zu pairs of labels touch%s\n", between, between > 64 ? " (listed in --json)" : "");
+      for (const LabelContact& t : table.contacts) {
+        if (t.a == 0) continue;
+        contacts.push_back({{"labels", {t.a, t.b}}, {"sticks", t.sticks}});
+        if (between <= 64)
+          std::printf("  %s-%s %*lu sticks\n", fmt(t.a).c_str(), fmt(t.b).c_str(), 20, (unsigned long)t.sticks);
+      }
+      j["contacts"] = contacts;
     }
   } else {
     double lo = v.value(0), hi = lo;

@@ -19,6 +19,7 @@ struct PressCmd {
   bool no_flats = false, no_sharpen = false, color_regions = false;
   bool ascii = false, check = false;
   std::string method = "pressing";
+  std::string labels, label_names, format = "ply";
   MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
   CLI::App* cmd = nullptr;
 };
@@ -111,7 +112,16 @@ void write_features(const std::string& path, const Mesh& mesh) {
 }
 
 void run_press(const PressCmd& c, const Global& g) {
-  check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.features, OutputKind::features}, {c.stats_json, OutputKind::json}});
+  const bool labels = !c.labels.empty();
+  if (labels) {
+    for (const char* name : {"--label", "--threshold", "--segment", "--features"})
+      if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --labels");
+    check_paths({c.input}, {{c.stats_json, OutputKind::json}});
+  } else {
+    for (const char* name : {"--label-names", "--format"})
+      if (c.cmd->count(name)) throw UsageError(std::string(name) + " needs --labels");
+    check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.features, OutputKind::features}, {c.stats_json, OutputKind::json}});
+  }
 
   SurfaceOptions so;
   so.method = parse_method(c.method);
@@ -138,10 +148,22 @@ void run_press(const PressCmd& c, const Global& g) {
   }
   so.overrides.lambda = c.overrides.lambda;
   so.overrides.mu = c.overrides.mu;
+  so.extract.max_bytes = g.memory_limit();
+  if (labels) {
+    LabelOutput o;
+    o.labels = c.labels;
+    o.names_file = c.label_names;
+    o.folder = c.output;
+    o.format = c.format;
+    o.stats_json = c.stats_json;
+    o.ascii = c.ascii;
+    o.check = c.check;
+    run_press_labels(c.input, c.in, so, o, g);
+    return;
+  }
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   so.progress = bar.get();
-  so.extract.max_bytes = g.memory_limit();
   const BinaryVolume volume = load_binary(c.input, c.in, g);
   const double seconds_read = clock.seconds();
   const SurfaceResult r = smooth_surface(volume, so);
@@ -204,8 +226,16 @@ void register_press(CLI::App& app, Global& g) {
   auto* cmd = app.add_subcommand("press", "Smooth surface of a volume: Pressing (vertices slide along their sticks, "
                                           "so no sample changes side)");
   cmd->add_option("input", c->input, "Volume file (or folder of TIFF slices)")->required();
-  cmd->add_option("-o,--output", c->output, "Output mesh (.ply .obj .stl .off .glb .gltf)")->required();
+  cmd->add_option("-o,--output", c->output, "Output mesh (.ply .obj .stl .off .glb .gltf); with --labels, a folder")
+      ->required();
   c->cmd = cmd;
+  auto* lm = cmd->add_option_group("label maps", "Every label at once: one closed mesh per label in the -o folder");
+  lm->add_option("--labels", c->labels,
+                 "all, or values like 1,5,7: one mesh per label, FOLDER/<name or label_N>.<format>, and "
+                 "FOLDER/labels.json");
+  lm->add_option("--label-names", c->label_names, "Label names, one 'VALUE NAME' per line (segment names of a "
+                                                  ".seg.nrrd are used without it)");
+  lm->add_option("--format", c->format, "Mesh format of --labels: ply, obj, stl, off, glb, gltf")->capture_default_str();
   cmd->add_option("--method", c->method,
                   "Smoothing method: pressing, cesn, diamond, cell-edge, cell-size, taubin or laplacian (all but "
                   "pressing are baselines; docs/ARCHITECTURE.md)")

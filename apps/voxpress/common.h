@@ -151,6 +151,21 @@ void write_json(const std::string& path, const nlohmann::json& j);
 uint64_t peak_rss_bytes();
 
 
+/// `press --labels`: one mesh per label into a folder (cmd_press_labels.cpp).
+struct LabelOutput {
+  std::string labels;      ///< "all" or "1,5,7"
+  std::string names_file;  ///< --label-names: "VALUE NAME" lines
+  std::string folder;      ///< -o
+  std::string format = "ply";
+  std::string stats_json;
+  bool ascii = false, check = false;
+};
+/// Throws UsageError for an unknown format, an -o that is a file, a missing
+/// or unwritable parent folder: before any work.
+void check_label_output(const LabelOutput& o);
+void run_press_labels(const std::string& input, const InputOptions& in, const SurfaceOptions& options,
+                      const LabelOutput& o, const Global& g);
+
 // Subcommand registration (one file each).
 void register_info(CLI::App& app, Global& g);
 void register_extract(CLI::App& app, Global& g);

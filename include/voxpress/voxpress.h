@@ -20,6 +20,7 @@
 #include "voxpress/smooth/pressing.h"
 #include "voxpress/smooth/mesh_smoothing.h"
 #include "voxpress/smooth/pipeline.h"
+#include "voxpress/labels/labels.h"
 #include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
 #include "voxpress/voxart/polygonize.h"

@@ -407,6 +407,73 @@ TEST(Cli, SharedLabelMapsPerLabel) {
   EXPECT_NE(out.find("4242"), std::string::npos);
 }
 
+// press --labels: one mesh per label into a folder, each read back and
+// checked against the whole volume for its own label; names from a table;
+// bad requests leave no folder at all.
+TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
+  test::TempDir tmp;
+  ScalarVolume v;
+  v.lattice.dims = {20, 18, 16};
+  v.lattice.spacing = Vec3(1, 1, 1.5);
+  v.type = ScalarType::u16;
+  v.bytes.assign(v.lattice.size() * 2, std::byte{0});
+  auto* w = reinterpret_cast<uint16_t*>(v.bytes.data());
+  for (int64_t k = 2; k < 14; ++k)
+    for (int64_t j = 2; j < 16; ++j)
+      for (int64_t i = 2; i < 18; ++i) {
+        const double x = i - 10.0, y = j - 9.0, z = (k - 8.0) * 1.5;
+        w[v.lattice.linear(i, j, k)] = x < 0 ? 7 : (x * x + y * y + z * z < 36 ? 300 : 12);
+      }
+  write_volume(tmp.path("map.nrrd"), v);
+  test::write_file(tmp.path("names.txt"), "7 left block\n300 ball\n");
+  std::string out;
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --label-names " + tmp.path("names.txt") +
+                        " -o " + tmp.path("organs") + " --check",
+                    &out),
+            0)
+      << out;
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(tmp.path("organs/labels.json")));
+  ASSERT_EQ(j["labels"].size(), 3u);
+  for (const auto& e : j["labels"]) {
+    const std::string file = tmp.path("organs/" + e["file"].get<std::string>());
+    ASSERT_TRUE(fs::exists(file)) << file;
+    EXPECT_EQ(run_cli("check " + file + " --volume " + tmp.path("map.nrrd") + " --label " +
+                          std::to_string(e["value"].get<int>()),
+                      &out),
+              0)
+        << out;
+    EXPECT_NE(out.find("0 violations"), std::string::npos) << out;
+    EXPECT_GE(e["touches"].size(), 2u);  // the background and a neighbour label
+  }
+  EXPECT_TRUE(fs::exists(tmp.path("organs/left_block.ply")));
+  EXPECT_TRUE(fs::exists(tmp.path("organs/ball.ply")));
+  EXPECT_TRUE(fs::exists(tmp.path("organs/label_12.ply")));
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 300,7 --format stl -o " + tmp.path("two"), &out), 0)
+      << out;
+  EXPECT_EQ(fs::exists(tmp.path("two/label_300.stl")) + fs::exists(tmp.path("two/label_7.stl")), 2);
+  EXPECT_FALSE(fs::exists(tmp.path("two/label_12.stl")));
+  // Refused before any output: absent label, -o a file, bad table, bad format, --label with --labels.
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 7,99 -o " + tmp.path("none"), &out), 1);
+  EXPECT_NE(out.find("99"), std::string::npos);
+  EXPECT_EQ(count_lines(out), 1u) << out;
+  EXPECT_FALSE(fs::exists(tmp.path("none")));
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all -o " + tmp.path("names.txt"), &out), 2);
+  test::write_file(tmp.path("bad.txt"), "7\n");
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --label-names " + tmp.path("bad.txt") +
+                        " -o " + tmp.path("none"),
+                    &out),
+            1);
+  EXPECT_NE(out.find("bad.txt"), std::string::npos);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --format xyz -o " + tmp.path("none"), &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --label 7 -o " + tmp.path("none"), &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --label-names " + tmp.path("names.txt") + " --label 7 -o " +
+                        tmp.path("x.ply"),
+                    &out),
+            2);
+  EXPECT_FALSE(fs::exists(tmp.path("none")));
+  EXPECT_FALSE(fs::exists(tmp.path("x.ply")));
+}
+
 TEST(Cli, PressSmoothsAndKeepsEverySampleOnItsSide) {
   test::TempDir tmp;
   std::string out;

@@ -1,0 +1,129 @@
+// voxpress press IN --labels all|1,5,7 -o FOLDER: every selected label of a
+// label map (or every segment of a .seg.nrrd) pressed in one process, one
+// closed mesh per label, plus FOLDER/labels.json (value, name, file, counts,
+// the labels each one touches). Nothing is written unless every label
+// succeeds (and passes --check).
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <unistd.h>
+
+#include "common.h"
+
+namespace voxpress::cli {
+namespace {
+
+std::string label_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Integer labels as JSON integers (labels.json reads "5", not "5.0").
+nlohmann::json value_json(double v) {
+  if (v == std::floor(v) && std::abs(v) < 9e15) return int64_t(v);
+  return v;
+}
+
+// A file name from a segment / table name: letters, digits, '-', '_' and
+// '.' kept, anything else '_'.
+std::string file_stem(const std::string& name) {
+  std::string out;
+  for (unsigned char ch : name) out += (std::isalnum(ch) || ch == '-' || ch == '_' || ch == '.') ? char(ch) : '_';
+  while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  return out;
+}
+
+}  // namespace
+
+void check_label_output(const LabelOutput& o) {
+  namespace fs = std::filesystem;
+  static const std::set<std::string> formats = {"ply", "obj", "stl", "off", "glb", "gltf"};
+  if (!formats.count(o.format)) throw UsageError("--format must be one of ply, obj, stl, off, glb, gltf, not '" + o.format + "'");
+  std::error_code ec;
+  if (fs::exists(o.folder, ec) && !fs::is_directory(o.folder, ec))
+    throw UsageError(o.folder + ": with --labels, -o names a folder (one mesh per label), and this is a file");
+  fs::path parent = fs::path(o.folder).lexically_normal().parent_path();
+  if (fs::path(o.folder).lexically_normal().filename().empty()) parent = parent.parent_path();  // "organs/"
+  if (parent.empty()) parent = ".";
+  const fs::path target = fs::is_directory(o.folder, ec) ? fs::path(o.folder) : parent;
+  if (!fs::is_directory(target, ec)) throw UsageError(o.folder + ": the folder " + target.string() + " does not exist");
+  if (::access(target.c_str(), W_OK) != 0) throw UsageError(o.folder + ": " + target.string() + " is not writable");
+  if (!o.names_file.empty()) check_paths({o.names_file}, {});
+}
+
+void run_press_labels(const std::string& input, const InputOptions& in, const SurfaceOptions& options,
+                      const LabelOutput& o, const Global& g) {
+  namespace fs = std::filesystem;
+  check_label_output(o);
+  Stopwatch clock;
+  ProgressBar bar(!g.quiet);
+  const ScalarVolume volume = load_volume(input, in, g);
+  LabelTable table = label_table(volume);
+  if (!o.names_file.empty()) {
+    const auto names = read_label_names(o.names_file);
+    for (LabelInfo& l : table.labels)
+      if (auto it = names.find(l.value); it != names.end()) l.name = it->second;
+  }
+  const std::vector<LabelInfo> chosen = select_labels(table, o.labels, input);
+  const double seconds_read = clock.seconds();
+  SurfaceOptions so = options;
+  so.progress = bar.get();
+  const std::vector<LabelSurface> surfaces = press_labels(volume, chosen, so);
+  const bool strict = keeps_classification(so.method);
+
+  // File names: the label's name when it has one and no other label shares it.
+  std::map<std::string, int> uses;
+  for (const LabelInfo& l : chosen) ++uses[file_stem(l.name)];
+  nlohmann::json list = nlohmann::json::array();
+  std::vector<std::string> files;
+  for (const LabelSurface& s : surfaces) {
+    const std::string stem = file_stem(s.label.name);
+    const std::string base = !stem.empty() && uses[stem] == 1 ? stem : "label_" + label_text(s.label.value) +
+                                                                          (stem.empty() ? "" : "_" + stem);
+    files.push_back((fs::path(o.folder) / (base + "." + o.format)).string());
+    nlohmann::json e = {{"value", value_json(s.label.value)},         {"name", s.label.name},
+                        {"layer", s.label.layer},         {"file", base + "." + o.format},
+                        {"samples", s.label.samples},     {"vertices", s.result.mesh.vertex_count()},
+                        {"triangles", s.result.mesh.face_count()}, {"flats", s.result.flats.flats.size()}};
+    nlohmann::json touches = nlohmann::json::array();
+    for (const LabelContact& c : table.contacts)
+      if (c.a == s.label.value || c.b == s.label.value)
+        touches.push_back({{"label", value_json(c.a == s.label.value ? c.b : c.a)}, {"sticks", c.sticks}});
+    e["touches"] = touches;
+    if (o.check) {
+      const BinaryVolume mask = label_mask(volume, s.label);
+      e["checks"] = check_surface(s.result.mesh, mask, bar.get(), "label " + label_text(s.label.value), strict);
+    }
+    list.push_back(e);
+  }
+  // Everything computed and checked: now the outputs.
+  fs::create_directories(o.folder);
+  MeshWriteOptions wo;
+  wo.ascii = o.ascii;
+  for (size_t i = 0; i < surfaces.size(); ++i) write_mesh(files[i], surfaces[i].result.mesh, wo);
+  nlohmann::json manifest = {{"input", input},
+                             {"layered", table.layered},
+                             {"lattice", lattice_json(volume.lattice)},
+                             {"labels", list}};
+  write_json((fs::path(o.folder) / "labels.json").string(), manifest);
+  size_t vertices = 0, triangles = 0;
+  for (const LabelSurface& s : surfaces) {
+    vertices += s.result.mesh.vertex_count();
+    triangles += s.result.mesh.face_count();
+  }
+  if (!g.quiet)
+    std::fprintf(stderr, "%s: %zu labels%s, %zu vertices, %zu triangles, %.2f s\n", o.folder.c_str(), surfaces.size(),
+                 table.layered ? " (layered segmentation: each segment meshed on its own layer)" : "", vertices,
+                 triangles, clock.seconds());
+  if (!o.stats_json.empty()) {
+    nlohmann::json j = manifest;
+    j["command"] = "press --labels";
+    j["seconds"] = {{"read", seconds_read}, {"total", clock.seconds()}};
+    j["peak_memory_bytes"] = peak_rss_bytes();
+    write_json(o.stats_json, j);
+  }
+}
+
+}  // namespace voxpress::cli

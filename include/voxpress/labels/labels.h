@@ -1,0 +1,87 @@
+// voxpress/labels/labels.h — label maps: every label of a volume in one call.
+//
+// A label map holds one integer value per sample (0 = background); a 3D
+// Slicer .seg.nrrd holds named segments, possibly in several overlapping
+// layers. label_table() finds every label in one pass over the samples: its
+// sample count, its bounding box and which labels it touches (lattice edges
+// between two labels, counted like sticks). press_labels() then meshes each
+// label alone on its bounding box grown by one sample (label_mask): the
+// samples beyond that box are not the label, so the surface is the one the
+// whole volume would give (the same sticks in the same order, only the index
+// origin moves), at the cost of the label's box instead of the volume.
+//
+// What this does not do yet (issue 54): the labels' surfaces are meshed
+// independently, so where two labels touch each places its own vertex on the
+// shared stick and the two walls are smoothed separately; each surface keeps
+// the binary guarantee for its own label (closed, 2-manifold, oriented, every
+// sample of the label inside, every other sample outside), and the surfaces
+// of two labels may cross each other near their common wall.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "voxpress/core/volume.h"
+#include "voxpress/smooth/pipeline.h"
+
+namespace voxpress {
+
+/// One label of a label map or one segment of a .seg.nrrd.
+struct LabelInfo {
+  double value = 0;          ///< the samples' value
+  int64_t layer = 0;         ///< the component (layer) holding it; 0 for plain label maps
+  std::string name;          ///< segment name, a --label-names entry, or empty
+  uint64_t samples = 0;      ///< samples with this value in its layer
+  std::array<int64_t, 3> lo{}, hi{};  ///< bounding box of those samples, inclusive
+};
+
+/// Two labels that touch: `sticks` lattice edges join a sample of each.
+/// a < b; either may be 0, the background.
+struct LabelContact {
+  double a = 0, b = 0;
+  uint64_t sticks = 0;
+};
+
+struct LabelTable {
+  std::vector<LabelInfo> labels;       ///< non-zero values (or segments), by layer then value
+  std::vector<LabelContact> contacts;  ///< single-layer volumes only; by (a, b)
+  bool layered = false;                ///< a 4-D .seg.nrrd: layers may overlap, each label is meshed on its own layer
+};
+
+/// Every label of `volume`: the distinct non-zero values (integers; a value
+/// with a fraction is an InputError: a grey image, use --threshold), or the
+/// segments of a .seg.nrrd with their names. Throws InputError (naming
+/// volume.source) when there is no label or more than max_labels.
+LabelTable label_table(const ScalarVolume& volume, size_t max_labels = 65535);
+
+/// The labels `text` selects from `table`: "all", or values "1,5,7" (an
+/// absent value is an InputError naming the file and the labels it has).
+std::vector<LabelInfo> select_labels(const LabelTable& table, const std::string& text, const std::string& source);
+
+/// Reads a label-name table (one "VALUE NAME" per line, separated by blanks,
+/// a comma or a tab; '#' starts a comment) — the form TotalSegmentator and
+/// ITK-SNAP label descriptions reduce to. Throws InputError naming the file
+/// and the line.
+std::map<double, std::string> read_label_names(const std::string& path);
+
+/// The label's samples as a binary volume on its bounding box grown by one
+/// sample on each side (clipped to the lattice), with the lattice's origin
+/// moved to the box's corner: physical positions are unchanged.
+BinaryVolume label_mask(const ScalarVolume& volume, const LabelInfo& label);
+
+struct LabelSurface {
+  LabelInfo label;
+  SurfaceResult result;  ///< result.mesh in the volume's physical frame
+};
+
+/// Each label's smooth surface by `options` (the same as smooth_surface on
+/// that label's mask alone), labels in parallel, results in the order given.
+/// Deterministic for any thread count. Throws what smooth_surface throws,
+/// prefixed with the label.
+std::vector<LabelSurface> press_labels(const ScalarVolume& volume, const std::vector<LabelInfo>& labels,
+                                       const SurfaceOptions& options = {});
+
+}  // namespace voxpress
