@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
+#include <sstream>
 
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
@@ -208,6 +210,52 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
   return out;
 }
 
+// Every label of a label map: {value: Mesh}, as `press --labels` computes it.
+py::dict py_press_labels(const py::object& array_like, const py::object& labels, const py::object& spacing,
+                         const py::object& origin, const py::object& direction, const std::string& method,
+                         const std::string& axes, const py::kwargs& kw) {
+  SurfaceOptions o;
+  o.method = parse_method(method);
+  set_options(o, kw);
+  const py::array array = py::module_::import("numpy").attr("asarray")(array_like);
+  const ScalarVolume scalar = to_volume(array, spacing, origin, direction, axes);
+  std::string selection = "all";
+  if (!labels.is_none()) {
+    selection.clear();
+    for (const py::handle& h : labels) {
+      const double v = h.cast<double>();
+      std::ostringstream text;
+      text.precision(17);
+      text << v;
+      selection += (selection.empty() ? "" : ",") + text.str();
+    }
+    if (selection.empty()) throw UsageError("labels= selects no label");
+  }
+  std::vector<LabelSurface> surfaces;
+  {
+    py::gil_scoped_release release;
+    const LabelTable table = label_table(scalar);
+    surfaces = press_labels(scalar, select_labels(table, selection, scalar.source), o);
+  }
+  py::dict out;
+  for (LabelSurface& s : surfaces) {
+    PyMesh m;
+    m.mesh = std::move(s.result.mesh);
+    m.stats["label"] = s.label.value;
+    m.stats["samples"] = s.label.samples;
+    m.stats["vertices"] = m.mesh.vertex_count();
+    m.stats["triangles"] = m.mesh.face_count();
+    m.stats["flats"] = s.result.flats.flats.size();
+    m.stats["keeps_classification"] = keeps_classification(o.method);
+    const double v = s.label.value;
+    if (v == std::floor(v) && std::abs(v) < 9e15)
+      out[py::int_(int64_t(v))] = std::move(m);
+    else
+      out[py::float_(v)] = std::move(m);
+  }
+  return out;
+}
+
 // A volume argument of check/evaluate: a file path, or a mask array on a lattice.
 BinaryVolume binary_argument(const py::object& volume, const py::dict& lattice, ScalarVolume* scalar_out) {
   const py::object none = py::none();
@@ -383,6 +431,10 @@ PYBIND11_MODULE(_voxpress, m) {
         py::arg("method") = "pressing", py::arg("axes") = "xyz", py::arg("label") = py::none(),
         py::arg("threshold") = py::none(),
         "The smooth surface of a mask (see voxpress/__init__.pyi).");
+  m.def("press_labels", &py_press_labels, py::arg("array"), py::kw_only(), py::arg("labels") = py::none(),
+        py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
+        py::arg("direction") = py::none(), py::arg("method") = "pressing", py::arg("axes") = "xyz",
+        "Every label's smooth surface: {label: Mesh} (see voxpress/__init__.pyi).");
   m.def("read_volume", [](const std::string& path) {
         ScalarVolume* v = nullptr;
         {

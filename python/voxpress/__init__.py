@@ -61,5 +61,25 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
                            label=label, threshold=threshold,
                            **{k: v for k, v in options.items() if v is not None})
 
-__all__ = ["Error", "InputError", "LimitError", "UsageError", "Lattice", "Mesh", "press", "read_volume",
+
+def press_labels(array, labels=None, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
+                 method="pressing", axes="xyz", **options):
+    """Every label of a label map at once, as `voxpress press --labels`: {label: Mesh}.
+
+    array: integer label map (0 = background); labels: None for every
+    non-zero value, or an iterable of values (an absent one raises
+    InputError). Each label is meshed on its bounding box, labels in
+    parallel; each mesh keeps its own label's samples inside and every other
+    sample outside. The labels' surfaces are independent (issue 54: shared
+    interfaces are not there yet). spacing, origin, direction, axes, method
+    and the options are press()'s.
+    """
+    if "disable_passes" in options and options["disable_passes"] is not None:
+        options["disable_passes"] = list(options["disable_passes"])
+    return _voxpress.press_labels(array, labels=None if labels is None else list(labels), spacing=spacing,
+                                  origin=origin, direction=direction, method=method, axes=axes,
+                                  **{k: v for k, v in options.items() if v is not None})
+
+
+__all__ = ["Error", "InputError", "LimitError", "UsageError", "Lattice", "Mesh", "press", "press_labels", "read_volume",
            "read_mesh", "check", "evaluate", "__version__"]

@@ -86,6 +86,25 @@ def press(
     direction of index axis a. The GIL is released while it works.
     """
 
+def press_labels(
+    array: npt.ArrayLike,
+    labels: Optional[Sequence[float]] = None,
+    *,
+    spacing: Sequence[float] = (1.0, 1.0, 1.0),
+    origin: Sequence[float] = (0.0, 0.0, 0.0),
+    direction: Optional[npt.ArrayLike] = None,
+    method: Method = "pressing",
+    axes: Literal["xyz", "zyx"] = "xyz",
+    **options: Any,
+) -> dict[float, Mesh]:
+    """Every label of an integer label map (0 = background) at once: {label: Mesh}.
+
+    labels=None takes every non-zero value; an absent value raises
+    InputError. Each mesh keeps its label's samples inside and all others
+    outside; the labels' surfaces are independent (no shared interfaces
+    yet). The options are press()'s (iterations, flats, sharpen, ...).
+    """
+
 def read_volume(path: str) -> Tuple[npt.NDArray[Any], Lattice]:
     """A volume file (NRRD, NIfTI, MetaImage, TIFF) as an array indexed [i, j, k] (no copy) and its lattice."""
 

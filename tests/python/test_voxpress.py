@@ -209,3 +209,25 @@ def test_press_shows_its_real_signature_and_docstring():
     assert "sharp_angle" in voxpress.press.__doc__
     with pytest.raises(TypeError, match="smoothness"):
         voxpress.press(ball(12, 4.5), smoothness=3)
+
+
+def test_press_labels_every_label_at_once(tmp_path):
+    n = 22
+    i, j, k = np.indices((n, n, n))
+    labels = np.zeros((n, n, n), np.uint16)
+    labels[(i > 2) & (i < 11) & (j > 2) & (j < 19) & (k > 2) & (k < 19)] = 4
+    labels[(i - 13) ** 2 + (j - 11) ** 2 + (k - 11) ** 2 < 36] = 9   # touches label 4
+    labels[(i - 14) ** 2 + (j - 11) ** 2 + (k - 11) ** 2 < 4] = 700  # nested in label 9
+    meshes = voxpress.press_labels(labels, spacing=(1, 1, 1.5))
+    assert sorted(meshes) == [4, 9, 700]
+    for value, mesh in meshes.items():
+        report = voxpress.check(mesh, labels == value, spacing=(1, 1, 1.5))
+        assert report["closed"] and report["manifold"] and report["oriented"], value
+        assert report["classification_violations"] == 0, value
+    some = voxpress.press_labels(labels, labels=[9], spacing=(1, 1, 1.5))
+    assert list(some) == [9]
+    np.testing.assert_array_equal(some[9].vertices, meshes[9].vertices)
+    with pytest.raises(voxpress.InputError, match="label 5"):
+        voxpress.press_labels(labels, labels=[4, 5])
+    with pytest.raises(voxpress.InputError):
+        voxpress.press_labels(np.zeros((4, 4, 4), np.uint8))
