@@ -187,6 +187,35 @@ TEST(Labels, AdversarialConfigurations) {
   }
 }
 
+// A layered (4-D) .seg.nrrd: two layers whose segments overlap; each
+// segment is meshed on its own layer, named, and keeps its own samples.
+TEST(Labels, LayeredSegmentationEverySegmentOnItsLayer) {
+  ScalarVolume v = label_volume({12, 12, 12});
+  v.components = 2;
+  v.bytes.assign(v.lattice.size() * 2, std::byte{0});
+  for (int64_t k = 2; k < 10; ++k)
+    for (int64_t j = 2; j < 10; ++j)
+      for (int64_t i = 2; i < 10; ++i) {
+        const uint64_t s = v.lattice.linear(i, j, k);
+        v.bytes[2 * s] = std::byte(uint8_t(i < 6 ? 1 : 2));                         // layer 0: two halves
+        v.bytes[2 * s + 1] = std::byte(uint8_t(std::abs(i - 6) + std::abs(j - 6) < 3 ? 1 : 0));  // layer 1 overlaps both
+      }
+  v.segments = {{"Segment_1", "left", 1, 0}, {"Segment_2", "right", 2, 0}, {"Segment_3", "rod", 1, 1}};
+  const LabelTable t = label_table(v);
+  EXPECT_TRUE(t.layered);
+  ASSERT_EQ(t.labels.size(), 3u);
+  EXPECT_EQ(t.labels[2].name, "rod");
+  EXPECT_EQ(t.labels[2].layer, 1);
+  const auto surfaces = press_labels(v, t.labels);
+  for (const LabelSurface& s : surfaces) {
+    SCOPED_TRACE(s.label.name);
+    Selection sel;
+    sel.kind = Selection::Kind::segment;
+    sel.segment = s.label.name;
+    test::expect_guarantees(s.result.mesh, binarize(v, sel));
+  }
+}
+
 TEST(Labels, SameBytesForOneAndManyThreads) {
   const ScalarVolume v = phantom();
   const LabelTable t = label_table(v);
