@@ -80,8 +80,11 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   std::vector<std::string> files;
   for (const LabelSurface& s : surfaces) {
     const std::string stem = file_stem(s.label.name);
-    const std::string base = !stem.empty() && uses[stem] == 1 ? stem : "label_" + label_text(s.label.value) +
-                                                                          (stem.empty() ? "" : "_" + stem);
+    // Layers of a .seg.nrrd may reuse a value: the layer is then part of the name.
+    const std::string layer = table.layered ? "_layer" + std::to_string(s.label.layer) : "";
+    const std::string base = !stem.empty() && uses[stem] == 1
+                                 ? stem
+                                 : "label_" + label_text(s.label.value) + layer + (stem.empty() ? "" : "_" + stem);
     files.push_back((fs::path(o.folder) / (base + "." + o.format)).string());
     nlohmann::json e = {{"value", value_json(s.label.value)},         {"name", s.label.name},
                         {"layer", s.label.layer},         {"file", base + "." + o.format},

@@ -192,8 +192,11 @@ std::vector<LabelInfo> select_labels(const LabelTable& table, const std::string&
     bool found = false;
     for (const LabelInfo& l : table.labels)
       if (l.value == value) {
-        out.push_back(l);
         found = true;
+        const bool twice = std::any_of(out.begin(), out.end(), [&](const LabelInfo& o) {
+          return o.value == l.value && o.layer == l.layer;
+        });
+        if (!twice) out.push_back(l);  // "5,5" is label 5 once
       }
     if (!found) {
       std::string have;

@@ -452,6 +452,8 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
       << out;
   EXPECT_EQ(fs::exists(tmp.path("two/label_300.stl")) + fs::exists(tmp.path("two/label_7.stl")), 2);
   EXPECT_FALSE(fs::exists(tmp.path("two/label_12.stl")));
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 7,7 -o " + tmp.path("once"), &out), 0) << out;
+  EXPECT_EQ(nlohmann::json::parse(test::read_file(tmp.path("once/labels.json")))["labels"].size(), 1u);
   // Refused before any output: absent label, -o a file, bad table, bad format, --label with --labels.
   EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 7,99 -o " + tmp.path("none"), &out), 1);
   EXPECT_NE(out.find("99"), std::string::npos);
