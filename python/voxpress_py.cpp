@@ -12,7 +12,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <sstream>
 
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
@@ -219,23 +218,16 @@ py::dict py_press_labels(const py::object& array_like, const py::object& labels,
   set_options(o, kw);
   const py::array array = py::module_::import("numpy").attr("asarray")(array_like);
   const ScalarVolume scalar = to_volume(array, spacing, origin, direction, axes);
-  std::string selection = "all";
+  std::vector<double> values;  // empty: every label
   if (!labels.is_none()) {
-    selection.clear();
-    for (const py::handle& h : labels) {
-      const double v = h.cast<double>();
-      std::ostringstream text;
-      text.precision(17);
-      text << v;
-      selection += (selection.empty() ? "" : ",") + text.str();
-    }
-    if (selection.empty()) throw UsageError("labels= selects no label");
+    for (const py::handle& h : labels) values.push_back(h.cast<double>());
+    if (values.empty()) throw UsageError("labels= selects no label");
   }
   std::vector<LabelSurface> surfaces;
   {
     py::gil_scoped_release release;
     const LabelTable table = label_table(scalar);
-    surfaces = press_labels(scalar, select_labels(table, selection, scalar.source), o);
+    surfaces = press_labels(scalar, select_labels(table, values, scalar.source), o);
   }
   py::dict out;
   for (LabelSurface& s : surfaces) {

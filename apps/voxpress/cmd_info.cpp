@@ -1,6 +1,7 @@
 // voxpress info FILE: lattice, voxel type, labels with counts, sticks.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "common.h"
 
@@ -47,16 +48,30 @@ void run_info(const InfoCmd& c, const Global& g) {
     size_t nonzero = 0;
     for (auto& [value, n] : *hist) nonzero += value != 0;
     const bool per_label = nonzero <= 64 && v.components == 1;
+    // Integer label maps: one pass gives every label's contacts, whose sums
+    // are the labels' sticks (a pass per label otherwise).
+    bool integers = true;
+    for (auto& [value, n] : *hist) integers = integers && value == std::floor(value);
+    std::optional<LabelTable> table;
+    if (v.components == 1 && nonzero > 0 && integers) table = label_table(v);
+    auto sticks_of = [&](double value) {
+      uint64_t n = 0;
+      if (table) {
+        for (const LabelContact& t : table->contacts) n += (t.a == value || t.b == value) ? t.sticks : 0;
+        return n;
+      }
+      Selection s;
+      s.kind = Selection::Kind::label;
+      s.value = value;
+      return count_sticks(binarize(v, s));
+    };
     std::printf("values      %zu distinct\n", hist->size());
     std::printf("  %-12s %14s %12s\n", "value", "samples", per_label ? "sticks" : "");
     for (auto& [value, n] : *hist) {
       nlohmann::json e = {{"value", value}, {"samples", n}};
       std::string sticks;
       if (per_label && value != 0) {
-        Selection s;
-        s.kind = Selection::Kind::label;
-        s.value = value;
-        const uint64_t ns = count_sticks(binarize(v, s));
+        const uint64_t ns = sticks_of(value);
         e["sticks"] = ns;
         sticks = std::to_string(ns);
       }
@@ -64,15 +79,12 @@ void run_info(const InfoCmd& c, const Global& g) {
       std::printf("  %-12s %14lu %12s\n", fmt(value).c_str(), (unsigned long)n, sticks.c_str());
     }
     // Which labels touch (lattice edges between them), for label maps.
-    bool integers = true;
-    for (auto& [value, n] : *hist) integers = integers && value == std::floor(value);
-    if (v.components == 1 && nonzero > 1 && integers) {
-      const LabelTable table = label_table(v);
+    if (table && nonzero > 1) {
       nlohmann::json contacts = nlohmann::json::array();
       size_t between = 0;
-      for (const LabelContact& t : table.contacts) between += t.a != 0;
+      for (const LabelContact& t : table->contacts) between += t.a != 0;
       std::printf("contacts    %zu pairs of labels touch%s\n", between, between > 64 ? " (listed in --json)" : "");
-      for (const LabelContact& t : table.contacts) {
+      for (const LabelContact& t : table->contacts) {
         if (t.a == 0) continue;
         contacts.push_back({{"labels", {t.a, t.b}}, {"sticks", t.sticks}});
         if (between <= 64)

@@ -14,12 +14,6 @@
 namespace voxpress::cli {
 namespace {
 
-std::string label_text(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // Integer labels as JSON integers (labels.json reads "5", not "5.0").
 nlohmann::json value_json(double v) {
   if (v == std::floor(v) && std::abs(v) < 9e15) return int64_t(v);
@@ -66,7 +60,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
     for (LabelInfo& l : table.labels)
       if (auto it = names.find(l.value); it != names.end()) l.name = it->second;
   }
-  const std::vector<LabelInfo> chosen = select_labels(table, o.labels, input);
+  const std::vector<LabelInfo> chosen = select_labels(table, parse_label_list(o.labels), input);
   const double seconds_read = clock.seconds();
   SurfaceOptions so = options;
   so.progress = bar.get();
@@ -84,7 +78,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
     const std::string layer = table.layered ? "_layer" + std::to_string(s.label.layer) : "";
     const std::string base = !stem.empty() && uses[stem] == 1
                                  ? stem
-                                 : "label_" + label_text(s.label.value) + layer + (stem.empty() ? "" : "_" + stem);
+                                 : "label_" + format_value(s.label.value) + layer + (stem.empty() ? "" : "_" + stem);
     files.push_back((fs::path(o.folder) / (base + "." + o.format)).string());
     nlohmann::json e = {{"value", value_json(s.label.value)},         {"name", s.label.name},
                         {"layer", s.label.layer},         {"file", base + "." + o.format},
@@ -97,7 +91,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
     e["touches"] = touches;
     if (o.check) {
       const BinaryVolume mask = label_mask(volume, s.label);
-      e["checks"] = check_surface(s.result.mesh, mask, bar.get(), "label " + label_text(s.label.value), strict);
+      e["checks"] = check_surface(s.result.mesh, mask, bar.get(), "label " + format_value(s.label.value), strict);
     }
     list.push_back(e);
   }

@@ -74,13 +74,13 @@ Selection parse_label_selection(const std::string& text) {
   return s;
 }
 
-namespace {
-
 std::string format_value(double v) {
   std::ostringstream o;
   o << v;
   return o.str();
 }
+
+namespace {
 
 // First non-zero value and whether another, different non-zero value exists.
 struct NonzeroSummary {

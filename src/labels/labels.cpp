@@ -20,12 +20,6 @@
 namespace voxpress {
 namespace {
 
-std::string format_label(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // Maps a layer's values to dense label numbers (0 = background), with a
 // table for 8- and 16-bit types and a hash map with a one-entry cache (label
 // maps come in runs) otherwise.
@@ -50,7 +44,7 @@ class LabelIndex {
       } else {
         const double d = double(x);
         if (!std::isfinite(d) || d != std::floor(d))
-          throw InputError(source_, "value " + format_label(d) +
+          throw InputError(source_, "value " + format_value(d) +
                                         " is not an integer label: this looks like a grey image (use --threshold T)");
         id = add(d);
         map_.emplace(x, id);
@@ -179,9 +173,9 @@ LabelTable label_table(const ScalarVolume& v, size_t max_labels) {
   return t;
 }
 
-std::vector<LabelInfo> select_labels(const LabelTable& table, const std::string& text, const std::string& source) {
-  if (text == "all") return table.labels;
-  std::vector<LabelInfo> out;
+std::vector<double> parse_label_list(const std::string& text) {
+  if (text == "all") return {};
+  std::vector<double> values;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
@@ -189,6 +183,17 @@ std::vector<LabelInfo> select_labels(const LabelTable& table, const std::string&
     const double value = std::strtod(item.c_str(), &end);
     if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(value))
       throw UsageError("--labels takes 'all' or values like 1,5,7, not '" + text + "'");
+    values.push_back(value);
+  }
+  if (values.empty()) throw UsageError("--labels selects no label");
+  return values;
+}
+
+std::vector<LabelInfo> select_labels(const LabelTable& table, const std::vector<double>& values,
+                                     const std::string& source) {
+  if (values.empty()) return table.labels;
+  std::vector<LabelInfo> out;
+  for (const double value : values) {
     bool found = false;
     for (const LabelInfo& l : table.labels)
       if (l.value == value) {
@@ -201,12 +206,11 @@ std::vector<LabelInfo> select_labels(const LabelTable& table, const std::string&
     if (!found) {
       std::string have;
       for (size_t i = 0; i < table.labels.size() && i < 20; ++i)
-        have += (i ? ", " : "") + format_label(table.labels[i].value);
+        have += (i ? ", " : "") + format_value(table.labels[i].value);
       if (table.labels.size() > 20) have += ", ...";
-      throw InputError(source, "no sample has label " + item + " (labels: " + have + ")");
+      throw InputError(source, "no sample has label " + format_value(value) + " (labels: " + have + ")");
     }
   }
-  if (out.empty()) throw UsageError("--labels selects no label");
   return out;
 }
 
@@ -284,7 +288,7 @@ std::vector<LabelSurface> press_labels(const ScalarVolume& v, const std::vector<
       std::lock_guard lock(failure_mutex);
       if (i < failed_at) {
         failed_at = i;
-        const std::string what = "label " + format_label(labels[i].value) +
+        const std::string what = "label " + format_value(labels[i].value) +
                                  (labels[i].name.empty() ? "" : " (" + labels[i].name + ")") + ": ";
         if (const auto* le = dynamic_cast<const LimitError*>(&e))
           failure = std::make_exception_ptr(LimitError(le->path(), what + le->problem()));

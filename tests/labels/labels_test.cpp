@@ -248,9 +248,12 @@ TEST(Labels, BadInputIsRefusedNamingTheFile) {
   }
   const ScalarVolume v = phantom();
   const LabelTable t = label_table(v);
-  EXPECT_THROW(select_labels(t, "2,9", v.source), InputError);
-  EXPECT_THROW(select_labels(t, "2,x", v.source), UsageError);
-  EXPECT_EQ(select_labels(t, "4,2", v.source).size(), 2u);
+  EXPECT_THROW(select_labels(t, parse_label_list("2,9"), v.source), InputError);
+  EXPECT_THROW(parse_label_list("2,x"), UsageError);
+  EXPECT_THROW(parse_label_list(""), UsageError);
+  EXPECT_TRUE(parse_label_list("all").empty());
+  EXPECT_EQ(select_labels(t, parse_label_list("all"), v.source).size(), t.labels.size());
+  EXPECT_EQ(select_labels(t, parse_label_list("4,2,4"), v.source).size(), 2u);
   EXPECT_THROW(label_table(v, 2), InputError);  // more labels than allowed
   test::TempDir tmp;
   test::write_file(tmp.path("names.txt"), "# value name\n1 box\n2,sphere\n3\tinner sphere\n");

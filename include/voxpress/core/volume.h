@@ -84,6 +84,10 @@ struct Selection {
   std::string segment;   ///< segment name or ID for Kind::segment
 };
 
+/// A sample value as messages and file names print it (default stream
+/// precision: 5, 2.5, 1e+20).
+std::string format_value(double v);
+
 /// Parses the CLI forms "N", "all-nonzero" (label) and "T" (threshold).
 Selection parse_label_selection(const std::string& text);
 

@@ -57,9 +57,15 @@ struct LabelTable {
 /// volume.source) when there is no label or more than max_labels.
 LabelTable label_table(const ScalarVolume& volume, size_t max_labels = 65535);
 
-/// The labels `text` selects from `table`: "all", or values "1,5,7" (an
-/// absent value is an InputError naming the file and the labels it has).
-std::vector<LabelInfo> select_labels(const LabelTable& table, const std::string& text, const std::string& source);
+/// The values of the CLI form "1,5,7"; "all" gives none (every label).
+/// Throws UsageError for anything else.
+std::vector<double> parse_label_list(const std::string& text);
+
+/// The labels with these values, in the order given, each once (every
+/// label when `values` is empty). An absent value is an InputError naming
+/// `source` and the labels it has.
+std::vector<LabelInfo> select_labels(const LabelTable& table, const std::vector<double>& values,
+                                     const std::string& source);
 
 /// Reads a label-name table (one "VALUE NAME" per line, separated by blanks,
 /// a comma or a tab; '#' starts a comment) — the form TotalSegmentator and
