@@ -21,6 +21,7 @@ struct PressCmd {
   std::string method = "pressing";
   std::string labels, label_names, format = "ply";
   MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
+  ChunkOptions chunks;
   CLI::App* cmd = nullptr;
 };
 
@@ -111,6 +112,46 @@ void write_features(const std::string& path, const Mesh& mesh) {
   write_mesh(path, f);
 }
 
+// press --chunk: block by block (chunk/chunked.h); flats and sharp edges off.
+void run_press_chunked(const PressCmd& c, SurfaceOptions so, const Global& g) {
+  if (so.method != Method::pressing) throw UsageError("--chunk runs --method pressing only");
+  for (const char* name : {"--labels", "--features", "--color-regions", "--min-flat-area", "--junction-angle",
+                           "--sharp-angle", "--no-sharpen"})
+    if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --chunk (no flats across blocks yet)");
+  Stopwatch clock;
+  ProgressBar bar(!g.quiet);
+  so.progress = bar.get();
+  const BinaryVolume volume = load_binary(c.input, c.in, g);
+  const double seconds_read = clock.seconds();
+  const BlockReader read = [&](const Box& box) { return crop(volume, box); };
+  ChunkedStats st;
+  const Mesh mesh = press_chunked(volume.lattice, c.input, read, so, c.chunks, &st);
+  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), c.method, true) : nlohmann::json();
+  MeshWriteOptions wo;
+  wo.ascii = c.ascii;
+  write_mesh(c.output, mesh, wo);
+  if (!g.quiet)
+    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu blocks of %lld (halo %lld, %zu with surface), %d levels, "
+                 "at most %d iterations; no flats (--chunk)\n",
+                 c.output.c_str(), mesh.vertex_count(), mesh.face_count(), st.blocks, (long long)c.chunks.chunk,
+                 (long long)c.chunks.halo, st.pressed, st.levels, st.max_iterations);
+  if (!c.stats_json.empty()) {
+    ExtractStats es;
+    es.samples = volume.lattice.size();
+    es.sticks = st.sticks;
+    es.triangles = st.triangles;
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, volume, es, mesh);
+    j["method"] = c.method;
+    j["chunks"] = {{"chunk", c.chunks.chunk}, {"halo", c.chunks.halo}, {"blocks", st.blocks},
+                   {"blocks_with_surface", st.pressed}, {"levels", st.levels}, {"max_iterations", st.max_iterations}};
+    j["seconds"] = {{"read", seconds_read}, {"summary", st.seconds_summary}, {"blocks", st.seconds_blocks},
+                    {"stitch", st.seconds_stitch}, {"total", clock.seconds()}};
+    j["peak_memory_bytes"] = peak_rss_bytes();
+    if (c.check) j["checks"] = checks;
+    write_json(c.stats_json, j);
+  }
+}
+
 void run_press(const PressCmd& c, const Global& g) {
   const bool labels = !c.labels.empty();
   if (labels) {
@@ -161,6 +202,11 @@ void run_press(const PressCmd& c, const Global& g) {
     run_press_labels(c.input, c.in, so, o, g);
     return;
   }
+  if (c.cmd->count("--chunk")) {
+    run_press_chunked(c, so, g);
+    return;
+  }
+  if (c.cmd->count("--halo")) throw UsageError("--halo needs --chunk");
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   so.progress = bar.get();
@@ -271,6 +317,12 @@ void register_press(CLI::App& app, Global& g) {
                   "layer): " + pass_names)
       ->delimiter(',');
   sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
+  auto* ch = cmd->add_option_group("chunks", "Block by block, for volumes larger than memory (no flats)");
+  ch->add_option("--chunk", c->chunks.chunk, "Press blocks of this many samples per side and stitch them")
+      ->check(CLI::Range(int64_t(8), int64_t(1) << 20));
+  ch->add_option("--halo", c->chunks.halo, "Samples each block reads beyond its own on every side")
+      ->check(CLI::Range(int64_t(1), int64_t(256)))
+      ->capture_default_str();
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");

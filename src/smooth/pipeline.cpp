@@ -115,17 +115,41 @@ void validate(const SurfaceOptions& o) {
   in_range(o.sharp.margin, 1e-4, 0.49, "sharpen margin");
 }
 
+void require_float32_room(const Lattice& lattice, const SurfaceOptions& o, const std::string& source) {
+  // The output keeps the guarantee in float32 only if its rounding (delta / 4)
+  // stays well inside the clearance the pressing margin gives every sample
+  // (margin / sqrt(3)): a lattice far from the origin for its spacing cannot.
+  if (const double delta = detail::float32_clearance(lattice); delta > o.press.margin)
+    throw InputError(source, "its coordinates are too large for its spacing to be stored in float32 with "
+                             "every sample on its side (rounding " + detail::format_double(delta / 4) +
+                             " cells; move the origin closer to the volume)");
+}
+
+void press_stick_surface(StickSurface& surface, const SurfaceOptions& o, SurfaceResult& r) {
+  const PassSet& on = o.passes;
+  PressOptions po = o.press;
+  FlatOptions fo = o.flat;
+  fo.passes = on;
+  if (o.progress) po.progress = fo.progress = o.progress;
+  po.free_ends = po.free_ends && on.on(Pass::free_ends);
+  o.overrides.apply(po);
+  const bool features = on.on(Pass::flats);
+  const SliceCurves curves = build_slice_curves(surface);
+  const FeaturePressStats fs = press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats);
+  r.press = fs.press;
+  r.pass_times = fs.passes;
+  QuadricFitOptions qo = o.fit;
+  qo.margin = po.margin;
+  if (!on.on(Pass::quadric_fit)) qo.rings = 0;
+  r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
+  r.pass_times.add(Pass::quadric_fit, r.fit.seconds, r.fit.moved);
+}
+
 SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
   const MethodOverrides& ov = o.overrides;
   validate(o);
   require_mixed(volume);
-  // The output keeps the guarantee in float32 only if its rounding (delta / 4)
-  // stays well inside the clearance the pressing margin gives every sample
-  // (margin / sqrt(3)): a lattice far from the origin for its spacing cannot.
-  if (const double delta = detail::float32_clearance(volume.lattice); delta > o.press.margin)
-    throw InputError(volume.source, "its coordinates are too large for its spacing to be stored in float32 with "
-                                    "every sample on its side (rounding " + detail::format_double(delta / 4) +
-                                    " cells; move the origin closer to the volume)");
+  require_float32_room(volume.lattice, o, volume.source);
   SurfaceResult r;
   auto t0 = std::chrono::steady_clock::now();
   ExtractOptions eo = o.extract;
@@ -136,23 +160,9 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   t0 = std::chrono::steady_clock::now();
   switch (o.method) {
     case Method::pressing: {
+      press_stick_surface(surface, o, r);
       const PassSet& on = o.passes;
-      PressOptions po = o.press;
-      FlatOptions fo = o.flat;
-      fo.passes = on;
-      if (o.progress) po.progress = fo.progress = o.progress;
-      po.free_ends = po.free_ends && on.on(Pass::free_ends);
-      ov.apply(po);
       const bool features = on.on(Pass::flats);
-      const SliceCurves curves = build_slice_curves(surface);
-      const FeaturePressStats fs = press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats);
-      r.press = fs.press;
-      r.pass_times = fs.passes;
-      QuadricFitOptions qo = o.fit;
-      qo.margin = po.margin;
-      if (!on.on(Pass::quadric_fit)) qo.rings = 0;
-      r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
-      r.pass_times.add(Pass::quadric_fit, r.fit.seconds, r.fit.moved);
       if (features && on.on(Pass::sharpen)) {
         SharpenOptions so = o.sharp;
         so.colors = o.color_regions;

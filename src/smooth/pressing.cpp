@@ -253,9 +253,7 @@ int resolve_levels(int requested, size_t n, const Lower& lower) {
       });
   int64_t extent = 0;
   for (size_t a = 0; n > 0 && a < D; ++a) extent = std::max(extent, box[a + D] + 1 - box[a]);
-  int levels = 2;
-  for (int64_t e = 192; extent >= e && levels < 8; e *= 2) ++levels;
-  return levels;
+  return press_levels_for_extent(requested, extent);
 }
 
 PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
@@ -450,6 +448,13 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
   const PressStats st = iterate(t, families, 2, fz, br, o, press_levels(s, o.levels));
   tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[old_of[i]] = t[i]; });
   return st;
+}
+
+int press_levels_for_extent(int requested, int64_t extent) {
+  if (requested > 0) return requested;
+  int levels = 2;
+  for (int64_t e = 192; extent >= e && levels < 8; e *= 2) ++levels;
+  return levels;
 }
 
 int press_levels(const StickSurface& s, int requested) {

@@ -114,12 +114,12 @@ struct Packing {
 
 // The paper's packer (Section 4.5).
 Packing pack_paper(const std::vector<Chart>& charts) {
-  struct Node {
+  struct PackNode {
     int64_t w, h;
     int32_t left = -1, right = -1;
     bool stacked = false;  // right below left (else right beside left)
   };
-  std::vector<Node> nodes;
+  std::vector<PackNode> nodes;
   std::set<std::pair<int64_t, int32_t>> hb, vb;
   for (const Chart& c : charts) {
     nodes.push_back({c.w, c.h});
@@ -132,14 +132,14 @@ Packing pack_paper(const std::vector<Chart>& charts) {
     // "last two" of the paper's buffers sorted by decreasing size.
     const int32_t a1 = hb.begin()->second, a2 = std::next(hb.begin())->second;
     const int32_t b1 = vb.begin()->second, b2 = std::next(vb.begin())->second;
-    const Node A{std::max(nodes[size_t(a1)].w, nodes[size_t(a2)].w), nodes[size_t(a1)].h + nodes[size_t(a2)].h, a1, a2, true};
-    const Node B{nodes[size_t(b1)].w + nodes[size_t(b2)].w, std::max(nodes[size_t(b1)].h, nodes[size_t(b2)].h), b1, b2, false};
+    const PackNode A{std::max(nodes[size_t(a1)].w, nodes[size_t(a2)].w), nodes[size_t(a1)].h + nodes[size_t(a2)].h, a1, a2, true};
+    const PackNode B{nodes[size_t(b1)].w + nodes[size_t(b2)].w, std::max(nodes[size_t(b1)].h, nodes[size_t(b2)].h), b1, b2, false};
     // Waste measured against the enclosing square (the paper squares the
     // result): plain bounding-box waste keeps stacking narrow charts into
     // one ever taller column.
     const int64_t wa = std::max(A.w, A.h) * std::max(A.w, A.h) - area(a1) - area(a2);
     const int64_t wb = std::max(B.w, B.h) * std::max(B.w, B.h) - area(b1) - area(b2);
-    const Node chosen = wa <= wb ? A : B;
+    const PackNode chosen = wa <= wb ? A : B;
     for (int32_t i : {chosen.left, chosen.right}) {
       hb.erase({nodes[size_t(i)].w, i});
       vb.erase({nodes[size_t(i)].h, i});
@@ -159,7 +159,7 @@ Packing pack_paper(const std::vector<Chart>& charts) {
   while (!stack.empty()) {
     auto [i, x, y] = stack.back();
     stack.pop_back();
-    const Node& n = nodes[size_t(i)];
+    const PackNode& n = nodes[size_t(i)];
     if (n.left < 0) {
       p.at[size_t(i)] = {x, y};
       continue;

@@ -94,6 +94,17 @@ void validate(const SurfaceOptions& options);
 /// model smooth_surface checks against options.extract.max_bytes).
 uint64_t bytes_per_stick(const SurfaceOptions& options);
 
+/// Throws InputError(source, ...) when `lattice`'s coordinates are too large
+/// for float32 output to keep every sample on its side at options' margin.
+void require_float32_room(const Lattice& lattice, const SurfaceOptions& options, const std::string& source);
+
+/// The pressing stages that keep one vertex per stick, in place: Pressing
+/// (with flats and junctions when options.passes has them) and the local
+/// quadric fit; fills r.press, r.flats, r.fit, r.pass_times. smooth_surface
+/// runs it, then sharpens; the chunked run (chunk/chunked.h) stitches its
+/// blocks' sticks.
+void press_stick_surface(StickSurface& surface, const SurfaceOptions& options, SurfaceResult& r);
+
 /// The volume's smooth surface by `options.method`. Throws InputError for an
 /// empty or full volume, UsageError for invalid options, LimitError when
 /// options.extract.max_bytes would be exceeded.

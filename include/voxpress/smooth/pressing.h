@@ -125,6 +125,9 @@ PressStats press(StickSurface& surface, const PressOptions& options = {});
 
 /// PressOptions::levels resolved for this surface (0: by its extent).
 int press_levels(const StickSurface& surface, int requested);
+/// The same for a surface whose sticks' samples span `extent` cells along
+/// their longest side (what press_levels measures).
+int press_levels_for_extent(int requested, int64_t extent);
 
 /// Beyond the paper: a local quadric fit after pressing. The bilaplacian's
 /// fixed points are not circles, so tight curves stay pressed towards the

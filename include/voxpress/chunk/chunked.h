@@ -1,0 +1,124 @@
+// voxpress/chunk/chunked.h — Pressing block by block: volumes larger than
+// memory (`press --chunk`) and larger than one machine (voxpress.dask).
+//
+// The volume is cut into blocks of `chunk` samples per side. A block is read
+// with `halo` more samples on every side (clipped at the volume), pressed on
+// its own, and keeps only what it owns:
+//   - a stick, when its lower sample, clamped into the volume, lies in the
+//     block's core (a stick from the outside layer below the volume belongs
+//     to the block holding sample 0);
+//   - a cube's triangles, when the cube's lower corner, clamped the same way,
+//     lies in the core.
+// Every owned stick and cube lies at least one sample inside the block's
+// read box (halo >= 1), so the block sees its true samples: the stitched
+// surface has exactly the sticks, triangles and order of the whole-volume
+// run (stick s = whole-run stick s), and only the t of sticks near block
+// borders differs, by what the halo leaves of the block's artificial border
+// (docs/BENCHMARKS.md, Chunked). Pieces name sticks by global keys, so
+// stitching is a sort and a lookup: no welding, no duplicate, no crack.
+//
+// What differs from the whole-volume run: flats and sharp edges are off (a
+// plane crossing block borders would need one vote over all blocks), and
+// coarse-to-fine levels come from the whole volume's extent, so a block
+// presses with the same stages as the whole run.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/volume.h"
+#include "voxpress/extract/sticks.h"
+#include "voxpress/smooth/pipeline.h"
+
+namespace voxpress {
+
+/// A box of samples [lo, hi) per axis.
+struct Box {
+  std::array<int64_t, 3> lo{}, hi{};
+  uint64_t size() const { return uint64_t(hi[0] - lo[0]) * uint64_t(hi[1] - lo[1]) * uint64_t(hi[2] - lo[2]); }
+  std::array<int64_t, 3> dims() const { return {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}; }
+};
+
+struct ChunkOptions {
+  int64_t chunk = 256;  ///< block side, samples (>= 8)
+  /// Samples read beyond the block on every side (>= 1): enough for
+  /// Pressing's reach that a stitched vertex differs from the whole-volume
+  /// run by at most ~0.01 cell (measured per width: docs/BENCHMARKS.md).
+  int64_t halo = 24;
+};
+
+/// The blocks of a volume, x fastest then y then z.
+struct ChunkGrid {
+  std::array<int64_t, 3> dims{};  ///< the volume's samples per axis
+  int64_t chunk = 256, halo = 24;
+  ChunkGrid(const std::array<int64_t, 3>& dims, const ChunkOptions& o);
+  size_t count() const { return size_t(n_[0] * n_[1] * n_[2]); }
+  Box core(size_t b) const;       ///< the samples block b owns
+  Box with_halo(size_t b) const;  ///< core grown by halo, clipped to the volume
+
+ private:
+  std::array<int64_t, 3> n_{};  // blocks per axis
+};
+
+/// The whole volume's inside count and the bounding box of its inside
+/// samples (the pre-pass that sets levels and refuses empty or full volumes).
+struct VolumeSummary {
+  uint64_t inside = 0, samples = 0;
+  Box bounds{{INT64_MAX, INT64_MAX, INT64_MAX}, {INT64_MIN, INT64_MIN, INT64_MIN}};
+  void add(const BinaryVolume& block, const Box& where);  ///< where: block's box in the volume
+  void merge(const VolumeSummary& other);
+};
+
+/// What one block contributes, named by global keys (see stick_key).
+struct SurfacePiece {
+  std::vector<uint64_t> sticks;     ///< keys of the owned sticks, increasing
+  std::vector<uint8_t> code;        ///< StickSurface::code of each
+  std::vector<double> t;            ///< pressed t of each
+  std::vector<uint64_t> triangles;  ///< owned triangles: 3 stick keys each, in whole-run order
+  PressStats press;                 ///< the block's Pressing (iterations == 0: nothing to press)
+  uint64_t block = 0, blocks = 0;   ///< which block of how many (stitch wants each exactly once)
+};
+
+/// Global key of a stick: its lower sample (p, q, r) in padded index space
+/// (unpadded + 1) and axis a, ordered as the whole-volume run orders sticks:
+/// ((r * (ny + 2) + q) * 3 + a) * (nx + 2) + p.
+uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& padded_lower, int axis);
+
+/// Presses block b of `grid`: `samples` holds grid.with_halo(b) (its
+/// lattice's dims must match). options as chunk_surface_options returns them.
+SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options);
+
+/// Joins the blocks' pieces into the whole volume's stick surface (any piece
+/// order; deterministic). Throws UsageError unless the pieces are each block
+/// of one grid exactly once, std::logic_error if a triangle names a stick no
+/// piece owns (pieces pressed with different halos or volumes).
+StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pieces);
+
+struct ChunkedStats {
+  size_t blocks = 0, pressed = 0;  ///< blocks, and those with sticks to press
+  int levels = 0, max_iterations = 0;
+  uint64_t sticks = 0, triangles = 0, inside = 0;
+  double seconds_summary = 0, seconds_blocks = 0, seconds_stitch = 0;
+};
+
+/// Reads the samples of a box of the volume as a BinaryVolume of that box's
+/// size (its lattice's origin need not be set). Called from several threads.
+using BlockReader = std::function<BinaryVolume(const Box&)>;
+
+/// The chunked run: summary pass, blocks (in parallel, each read once with
+/// its halo), stitch. `lattice` is the whole volume's; `source` names it in
+/// errors. Refuses empty and full volumes like smooth_surface.
+Mesh press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
+                   const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats = nullptr);
+
+/// The samples of `box` of an in-memory volume.
+BinaryVolume crop(const BinaryVolume& volume, const Box& box);
+
+/// SurfaceOptions as the chunked run uses them: flats off, levels set from
+/// the whole volume's extent (summary.bounds), progress off.
+SurfaceOptions chunk_surface_options(const SurfaceOptions& options, const VolumeSummary& summary);
+
+}  // namespace voxpress

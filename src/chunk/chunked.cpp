@@ -1,0 +1,350 @@
+// Chunked Pressing: blocks with a halo, owned sticks and cubes, stitching by
+// global stick key. Theory of operation: include/voxpress/chunk/chunked.h.
+#include "voxpress/chunk/chunked.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <stdexcept>
+
+#include "core/timing.h"
+#include "voxpress/core/error.h"
+
+namespace voxpress {
+
+using detail::seconds_since;
+
+namespace {
+
+constexpr int64_t kMinChunk = 8;     // smaller blocks are all halo
+constexpr int64_t kMaxHalo = 256;    // beyond Pressing's reach at any level
+
+bool in_core(const Box& core, const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& g) {
+  for (int a = 0; a < 3; ++a) {
+    const int64_t c = std::clamp<int64_t>(g[size_t(a)], 0, dims[size_t(a)] - 1);
+    if (c < core.lo[size_t(a)] || c >= core.hi[size_t(a)]) return false;
+  }
+  return true;
+}
+
+struct KeyCodec {
+  uint64_t px, py;
+  explicit KeyCodec(const std::array<int64_t, 3>& dims) : px(uint64_t(dims[0] + 2)), py(uint64_t(dims[1] + 2)) {}
+  // padded (p, q, r) and axis of a key
+  std::array<uint64_t, 4> decode(uint64_t key) const {
+    const uint64_t p = key % px, rest = key / px, a = rest % 3, row = rest / 3;
+    return {p, row % py, row / py, a};
+  }
+};
+
+}  // namespace
+
+uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& pl, int axis) {
+  const uint64_t px = uint64_t(dims[0] + 2), py = uint64_t(dims[1] + 2);
+  return ((uint64_t(pl[2]) * py + uint64_t(pl[1])) * 3 + uint64_t(axis)) * px + uint64_t(pl[0]);
+}
+
+ChunkGrid::ChunkGrid(const std::array<int64_t, 3>& d, const ChunkOptions& o) : dims(d), chunk(o.chunk), halo(o.halo) {
+  if (chunk < kMinChunk) throw UsageError("--chunk must be at least " + std::to_string(kMinChunk) + " samples");
+  if (halo < 1 || halo > kMaxHalo) throw UsageError("the halo must be in [1, " + std::to_string(kMaxHalo) + "] samples");
+  for (int a = 0; a < 3; ++a) n_[size_t(a)] = (dims[size_t(a)] + chunk - 1) / chunk;
+}
+
+Box ChunkGrid::core(size_t b) const {
+  const int64_t idx[3] = {int64_t(b) % n_[0], (int64_t(b) / n_[0]) % n_[1], int64_t(b) / (n_[0] * n_[1])};
+  Box box;
+  for (int a = 0; a < 3; ++a) {
+    box.lo[size_t(a)] = idx[a] * chunk;
+    box.hi[size_t(a)] = std::min(dims[size_t(a)], box.lo[size_t(a)] + chunk);
+  }
+  return box;
+}
+
+Box ChunkGrid::with_halo(size_t b) const {
+  Box box = core(b);
+  for (int a = 0; a < 3; ++a) {
+    box.lo[size_t(a)] = std::max<int64_t>(0, box.lo[size_t(a)] - halo);
+    box.hi[size_t(a)] = std::min(dims[size_t(a)], box.hi[size_t(a)] + halo);
+  }
+  return box;
+}
+
+void VolumeSummary::add(const BinaryVolume& v, const Box& where) {
+  const auto& d = v.lattice.dims;
+  samples += v.lattice.size();
+  for (int64_t k = 0; k < d[2]; ++k)
+    for (int64_t j = 0; j < d[1]; ++j) {
+      const uint8_t* row = v.inside.data() + v.lattice.linear(0, j, k);
+      int64_t first = -1, last = -1, n = 0;
+      for (int64_t i = 0; i < d[0]; ++i)
+        if (row[i]) {
+          if (first < 0) first = i;
+          last = i;
+          ++n;
+        }
+      if (n == 0) continue;
+      inside += uint64_t(n);
+      const int64_t lo[3] = {where.lo[0] + first, where.lo[1] + j, where.lo[2] + k};
+      const int64_t hi[3] = {where.lo[0] + last + 1, lo[1] + 1, lo[2] + 1};
+      for (int a = 0; a < 3; ++a) {
+        bounds.lo[size_t(a)] = std::min(bounds.lo[size_t(a)], lo[a]);
+        bounds.hi[size_t(a)] = std::max(bounds.hi[size_t(a)], hi[a]);
+      }
+    }
+}
+
+void VolumeSummary::merge(const VolumeSummary& o) {
+  inside += o.inside;
+  samples += o.samples;
+  for (size_t a = 0; a < 3; ++a) {
+    bounds.lo[a] = std::min(bounds.lo[a], o.bounds.lo[a]);
+    bounds.hi[a] = std::max(bounds.hi[a], o.bounds.hi[a]);
+  }
+}
+
+BinaryVolume crop(const BinaryVolume& v, const Box& box) {
+  BinaryVolume out;
+  out.lattice = v.lattice;
+  out.lattice.dims = box.dims();
+  out.lattice.origin = v.lattice.to_physical(Vec3(double(box.lo[0]), double(box.lo[1]), double(box.lo[2])));
+  out.source = v.source;
+  out.inside.resize(box.size());
+  const int64_t nx = box.hi[0] - box.lo[0];
+  uint8_t* dst = out.inside.data();
+  for (int64_t k = box.lo[2]; k < box.hi[2]; ++k)
+    for (int64_t j = box.lo[1]; j < box.hi[1]; ++j, dst += nx)
+      std::copy_n(v.inside.data() + v.lattice.linear(box.lo[0], j, k), nx, dst);
+  return out;
+}
+
+SurfaceOptions chunk_surface_options(const SurfaceOptions& options, const VolumeSummary& summary) {
+  SurfaceOptions o = options;
+  o.passes.disable(Pass::flats);
+  o.progress = nullptr;
+  o.press.progress = nullptr;
+  o.extract.progress = nullptr;
+  // press_levels measures the box of the sticks' lower samples: the inside
+  // box grown by one below, so one more than the inside box's longest side.
+  int64_t extent = 0;
+  for (size_t a = 0; a < 3; ++a) extent = std::max(extent, summary.bounds.hi[a] - summary.bounds.lo[a] + 1);
+  o.press.levels = press_levels_for_extent(options.press.levels, extent);
+  return o;
+}
+
+SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_t b, const SurfaceOptions& options) {
+  const Box read = grid.with_halo(b), core = grid.core(b);
+  const auto& dims = grid.dims;
+  if (block.lattice.dims != read.dims() || block.inside.size() != read.size())
+    throw UsageError("press_block: the samples do not match block " + std::to_string(b) + "'s box with its halo");
+  SurfacePiece out;
+  out.block = b;
+  out.blocks = grid.count();
+  const uint64_t inside = block.count_inside();
+  if (inside == 0) return out;
+  bool touches_border = false;
+  for (size_t a = 0; a < 3; ++a) touches_border |= read.lo[a] == 0 || read.hi[a] == dims[a];
+  if (inside == block.lattice.size() && !touches_border) return out;  // its only sticks are the read box's faces
+
+  StickSurface s = extract_sticks(block, options.extract);
+  SurfaceResult r;
+  press_stick_surface(s, options, r);
+  out.press = r.press;
+
+  auto global_lower = [&](size_t id) {
+    auto l = s.lower_index(id);
+    for (size_t a = 0; a < 3; ++a) l[a] += read.lo[a];
+    return l;
+  };
+  auto key_of = [&](size_t id) {
+    auto l = global_lower(id);
+    for (int64_t& x : l) x += 1;
+    return stick_key(dims, l, s.axis(id));
+  };
+  for (size_t id = 0; id < s.stick_count(); ++id)
+    if (in_core(core, dims, global_lower(id))) {
+      out.sticks.push_back(key_of(id));
+      out.code.push_back(s.code[id]);
+      out.t.push_back(s.t[id]);
+    }
+  // A triangle's cube is the componentwise minimum of its three sticks' lower
+  // samples (no cube case has a triangle on one face: tests/chunk).
+  for (const Triangle& tri : s.triangles) {
+    std::array<int64_t, 3> corner{INT64_MAX, INT64_MAX, INT64_MAX};
+    for (uint32_t v : tri) {
+      const auto l = global_lower(v);
+      for (size_t a = 0; a < 3; ++a) corner[a] = std::min(corner[a], l[a]);
+    }
+    if (!in_core(core, dims, corner)) continue;
+    for (uint32_t v : tri) out.triangles.push_back(key_of(v));
+  }
+  return out;
+}
+
+StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pieces) {
+  const auto& dims = lattice.dims;
+  const KeyCodec codec(dims);
+  StickSurface out;
+  out.lattice = lattice;
+  out.padded = {dims[0] + 2, dims[1] + 2, dims[2] + 2};
+
+  std::vector<uint8_t> seen(pieces.empty() ? 0 : pieces[0].blocks, 0);
+  for (const SurfacePiece& p : pieces) {
+    if (p.blocks != seen.size() || p.block >= seen.size() || seen[p.block]++)
+      throw UsageError("stitch: the pieces are not each block of one grid exactly once");
+  }
+  if (pieces.size() != seen.size()) throw UsageError("stitch: " + std::to_string(seen.size() - pieces.size()) +
+                                                     " of the grid's " + std::to_string(seen.size()) + " blocks are missing");
+
+  // Sticks: (key, piece, index) sorted by key; keys are unique.
+  size_t n = 0, m = 0;
+  for (const SurfacePiece& p : pieces) n += p.sticks.size(), m += p.triangles.size() / 3;
+  if (n >= UINT32_MAX) throw LimitError("", std::to_string(n) + " sticks exceed the 2^32 - 1 vertex limit of one mesh");
+  struct Ref {
+    uint64_t key;
+    uint32_t piece, index;
+    bool operator<(const Ref& o) const { return key < o.key; }
+  };
+  std::vector<Ref> refs;
+  refs.reserve(n);
+  for (size_t p = 0; p < pieces.size(); ++p)
+    for (size_t i = 0; i < pieces[p].sticks.size(); ++i) refs.push_back({pieces[p].sticks[i], uint32_t(p), uint32_t(i)});
+  tbb::parallel_sort(refs.begin(), refs.end());
+  for (size_t i = 1; i < refs.size(); ++i)
+    if (refs[i].key == refs[i - 1].key) throw std::logic_error("stitch: a stick is owned by two pieces");
+  out.lower.resize(n);
+  out.code.resize(n);
+  out.t.resize(n);
+  std::vector<uint64_t> keys(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const Ref& ref = refs[i];
+      const auto d = codec.decode(ref.key);
+      keys[i] = ref.key;
+      out.lower[i] = d[0] + codec.px * (d[1] + codec.py * d[2]);
+      out.code[i] = pieces[ref.piece].code[ref.index];
+      out.t[i] = pieces[ref.piece].t[ref.index];
+    }
+  });
+  refs = {};
+
+  // Triangles in whole-run order: by cube (padded lower corner, z, y, x
+  // outer to inner), then in the cube's own order. A cube's triangles all
+  // come from one piece, consecutive, so (cube, position in the
+  // concatenation) is a strict total order.
+  struct Tri {
+    uint64_t cube, at;
+    bool operator<(const Tri& o) const { return cube != o.cube ? cube < o.cube : at < o.at; }
+  };
+  std::vector<Tri> order(m);
+  std::vector<const uint64_t*> first(m);
+  {
+    size_t w = 0;
+    for (const SurfacePiece& p : pieces)
+      for (size_t i = 0; i + 2 < p.triangles.size(); i += 3, ++w) first[w] = p.triangles.data() + i;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      uint64_t c[3] = {UINT64_MAX, UINT64_MAX, UINT64_MAX};
+      for (int v = 0; v < 3; ++v) {
+        const auto d = codec.decode(first[i][v]);
+        for (int a = 0; a < 3; ++a) c[a] = std::min(c[a], d[size_t(a)]);
+      }
+      order[i] = {c[0] + codec.px * (c[1] + codec.py * c[2]), i};
+    }
+  });
+  tbb::parallel_sort(order.begin(), order.end());
+  out.triangles.resize(m);
+  std::atomic<bool> missing{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i)
+      for (int v = 0; v < 3; ++v) {
+        const uint64_t key = first[order[i].at][v];
+        const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+        if (it == keys.end() || *it != key) {
+          missing = true;
+          continue;
+        }
+        out.triangles[i][size_t(v)] = uint32_t(it - keys.begin());
+      }
+  });
+  if (missing) throw std::logic_error("stitch: a triangle names a stick no piece owns");
+  return out;
+}
+
+Mesh press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
+                   const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats) {
+  if (options.method != Method::pressing) throw UsageError("--chunk runs --method pressing only");
+  validate(options);
+  require_float32_room(lattice, options, source);
+  const ChunkGrid grid(lattice.dims, chunks);
+  ChunkedStats st;
+  st.blocks = grid.count();
+
+  auto t0 = std::chrono::steady_clock::now();
+  VolumeSummary summary;
+  {
+    std::mutex mu;
+    ProgressCounter progress(options.progress, "summary", grid.count());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.count(), 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t b = r.begin(); b < r.end(); ++b) {
+        const Box core = grid.core(b);
+        VolumeSummary part;
+        part.add(read(core), core);
+        std::lock_guard lock(mu);
+        summary.merge(part);  // sums and min / max: order-independent
+        progress.add(1);
+      }
+    });
+  }
+  if (summary.inside == 0)
+    throw InputError(source, "the volume is empty: no sample is inside (check --label / --threshold)");
+  if (summary.inside == lattice.size())
+    throw InputError(source, "the volume is full: every sample is inside, so the only surface is the grid's bounding "
+                             "box (check --label / --threshold)");
+  st.inside = summary.inside;
+  st.seconds_summary = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  const SurfaceOptions so = chunk_surface_options(options, summary);
+  st.levels = so.press.levels;
+  std::vector<SurfacePiece> pieces(grid.count());
+  {
+    ProgressCounter progress(options.progress, "blocks", grid.count());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.count(), 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t b = r.begin(); b < r.end(); ++b) {
+        const Box box = grid.with_halo(b);
+        BinaryVolume block = read(box);
+        if (block.lattice.dims != box.dims() || block.inside.size() != box.size())
+          throw std::logic_error("press_chunked: the reader returned the wrong box");
+        block.lattice = lattice;
+        block.lattice.dims = box.dims();
+        block.lattice.origin = lattice.to_physical(Vec3(double(box.lo[0]), double(box.lo[1]), double(box.lo[2])));
+        block.source = source;
+        pieces[b] = press_block(block, grid, b, so);
+        progress.add(1);
+      }
+    });
+  }
+  for (const SurfacePiece& p : pieces) {
+    st.pressed += p.press.iterations > 0 || !p.sticks.empty();
+    st.max_iterations = std::max(st.max_iterations, p.press.iterations);
+  }
+  st.seconds_blocks = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  StickSurface surface = stitch(lattice, pieces);
+  pieces = {};
+  Mesh mesh = to_mesh(surface);
+  st.sticks = surface.stick_count();
+  st.triangles = surface.triangles.size();
+  st.seconds_stitch = seconds_since(t0);
+  if (stats) *stats = st;
+  return mesh;
+}
+
+}  // namespace voxpress

@@ -1,0 +1,175 @@
+// Chunked Pressing: the stitched surface is the whole-volume surface (same
+// sticks, triangles and order), keeps every guarantee, and is deterministic.
+#include <tbb/global_control.h>
+
+#include <algorithm>
+
+#include "test_util.h"
+
+namespace voxpress {
+namespace {
+
+using test::Rng;
+
+SurfaceOptions plain() {
+  SurfaceOptions o;
+  o.passes.disable(Pass::flats);
+  return o;
+}
+
+Mesh chunked(const BinaryVolume& v, int64_t chunk, int64_t halo, const SurfaceOptions& o = plain(),
+             ChunkedStats* st = nullptr) {
+  ChunkOptions c;
+  c.chunk = chunk;
+  c.halo = halo;
+  return press_chunked(v.lattice, v.source, [&](const Box& b) { return crop(v, b); }, o, c, st);
+}
+
+// The whole-volume run with the chunked run's options (flats off).
+Mesh whole(const BinaryVolume& v) { return smooth_surface(v, plain()).mesh; }
+
+double max_distance(const Mesh& a, const Mesh& b) {
+  double d = 0;
+  for (size_t i = 0; i < a.positions.size(); ++i) d = std::max(d, (a.positions[i] - b.positions[i]).norm());
+  return d;
+}
+
+TEST(Chunked, NoCubeCaseHasATriangleOnOneFace) {
+  // press_block finds a triangle's cube as the minimum of its sticks' lower
+  // samples: wrong if all three vertices sat on the cube's upper face.
+  for (unsigned mask = 0; mask < 256; ++mask) {
+    const CubeCase& c = cube_case(mask);
+    for (int k = 0; k < c.count; ++k)
+      for (int axis = 0; axis < 3; ++axis) {
+        bool lower = false;
+        for (int v = 0; v < 3; ++v) lower |= ((cube_edge_corner(c.triangles[size_t(k)][size_t(v)], 0) >> axis) & 1) == 0;
+        EXPECT_TRUE(lower) << "case " << mask << " triangle " << k << " axis " << axis;
+      }
+  }
+}
+
+TEST(Chunked, GridCoversTheVolumeOnce) {
+  const ChunkGrid g({37, 8, 20}, {.chunk = 16, .halo = 3});
+  ASSERT_EQ(g.count(), 3u * 1u * 2u);
+  uint64_t covered = 0;
+  for (size_t b = 0; b < g.count(); ++b) {
+    const Box c = g.core(b), h = g.with_halo(b);
+    covered += c.size();
+    for (size_t a = 0; a < 3; ++a) {
+      EXPECT_LE(h.lo[a], c.lo[a]);
+      EXPECT_GE(h.hi[a], c.hi[a]);
+      EXPECT_EQ(h.lo[a], std::max<int64_t>(0, c.lo[a] - 3));
+    }
+  }
+  EXPECT_EQ(covered, 37u * 8u * 20u);
+  EXPECT_THROW(ChunkGrid({8, 8, 8}, {.chunk = 4, .halo = 1}), UsageError);
+  EXPECT_THROW(ChunkGrid({8, 8, 8}, {.chunk = 8, .halo = 0}), UsageError);
+}
+
+TEST(Chunked, OneBlockIsTheWholeRunBitForBit) {
+  GenerateOptions g;
+  g.res = 40;
+  g.rotation = parse_rotation("random:3");
+  for (ShapeKind kind : {ShapeKind::sphere, ShapeKind::cad_part}) {
+    const GeneratedShape s = generate_shape(kind, g);
+    const Mesh a = whole(s.volume), b = chunked(s.volume, 64, 4);
+    EXPECT_EQ(a.triangles, b.triangles);
+    EXPECT_EQ(a.positions, b.positions);
+  }
+}
+
+TEST(Chunked, StitchedTopologyIsTheWholeRunsAndKeepsTheGuarantees) {
+  Rng rng(11);
+  std::vector<std::pair<std::string, BinaryVolume>> cases;
+  cases.emplace_back("noise", test::random_noise(rng, {29, 23, 19}, 0.5));
+  cases.emplace_back("blobs", test::random_blobs(rng, {33, 30, 26}, 5));
+  cases.emplace_back("checkerboard", test::checkerboard({17, 16, 18}));
+  {  // everything inside but one sample: the blocks without it are full
+    BinaryVolume v = test::make_volume(24, 20, 17);
+    std::fill(v.inside.begin(), v.inside.end(), 1);
+    v.inside[v.lattice.linear(12, 9, 8)] = 0;
+    cases.emplace_back("full but one", v);
+  }
+  {  // single voxels on block borders and corners
+    BinaryVolume v = test::make_volume(25, 25, 25);
+    for (int64_t c : {0, 7, 8, 15, 16, 24}) v.inside[v.lattice.linear(c, c, 24 - c)] = 1;
+    cases.emplace_back("voxels on borders", v);
+  }
+  for (const auto& [name, v] : cases)
+    for (int64_t halo : {1, 3}) {
+      SCOPED_TRACE(name + " halo " + std::to_string(halo));
+      const Mesh a = whole(v), b = chunked(v, 8, halo);
+      EXPECT_EQ(a.triangles, b.triangles);
+      ASSERT_EQ(a.positions.size(), b.positions.size());
+      test::expect_guarantees(b, v);
+    }
+}
+
+TEST(Chunked, AHaloOfTwentyFourMatchesTheWholeRun) {
+  // Bounds that hold over rotations (docs/BENCHMARKS.md, Chunked, has the
+  // figures per halo width): the halo's border effect fades with distance.
+  GenerateOptions g;
+  g.res = 80;
+  for (int seed = 1; seed <= 3; ++seed) {
+    g.rotation = parse_rotation("random:" + std::to_string(seed));
+    const GeneratedShape s = generate_shape(ShapeKind::sphere, g);
+    const Mesh a = whole(s.volume);
+    ChunkedStats st;
+    const Mesh near = chunked(s.volume, 40, 2, plain(), &st), far = chunked(s.volume, 40, 24);
+    EXPECT_EQ(st.blocks, 8u);
+    EXPECT_EQ(a.triangles, far.triangles);
+    EXPECT_LT(max_distance(a, far), 0.01);
+    EXPECT_GT(max_distance(a, near), max_distance(a, far));  // the halo is what makes it close
+  }
+}
+
+TEST(Chunked, SameBytesForAnyThreadCountAndPieceOrder) {
+  GenerateOptions g;
+  g.res = 40;
+  g.rotation = parse_rotation("random:5");
+  const GeneratedShape s = generate_shape(ShapeKind::cad_part, g);
+  Mesh one;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = chunked(s.volume, 16, 4);
+  }
+  const Mesh many = chunked(s.volume, 16, 4);
+  EXPECT_EQ(one.positions, many.positions);
+  EXPECT_EQ(one.triangles, many.triangles);
+  // Pieces stitched in reverse order give the same surface.
+  const ChunkGrid grid(s.volume.lattice.dims, {.chunk = 16, .halo = 4});
+  VolumeSummary summary;
+  summary.add(s.volume, Box{{0, 0, 0}, s.volume.lattice.dims});
+  const SurfaceOptions so = chunk_surface_options(plain(), summary);
+  std::vector<SurfacePiece> pieces;
+  for (size_t b = grid.count(); b-- > 0;) pieces.push_back(press_block(crop(s.volume, grid.with_halo(b)), grid, b, so));
+  const Mesh reversed = to_mesh(stitch(s.volume.lattice, pieces));
+  EXPECT_EQ(reversed.positions, many.positions);
+  EXPECT_EQ(reversed.triangles, many.triangles);
+  // A missing or doubled piece would be a hole or an overlap: refused.
+  pieces.push_back(pieces.front());
+  EXPECT_THROW(stitch(s.volume.lattice, pieces), UsageError);
+  pieces.pop_back();
+  pieces.pop_back();
+  EXPECT_THROW(stitch(s.volume.lattice, pieces), UsageError);
+  // A triangle naming a stick no piece owns is refused.
+  pieces.push_back(press_block(crop(s.volume, grid.with_halo(0)), grid, 0, so));
+  stitch(s.volume.lattice, pieces);
+  const uint64_t absent = stick_key(s.volume.lattice.dims, {1, 1, 1}, 0);  // sample (0, 0, 0) is outside the part
+  for (int v = 0; v < 3; ++v) pieces.back().triangles.push_back(absent);
+  EXPECT_THROW(stitch(s.volume.lattice, pieces), std::logic_error);
+}
+
+TEST(Chunked, EmptyAndFullVolumesAreRefused) {
+  BinaryVolume v = test::make_volume(20, 20, 20);
+  EXPECT_THROW(chunked(v, 8, 2), InputError);
+  std::fill(v.inside.begin(), v.inside.end(), 1);
+  EXPECT_THROW(chunked(v, 8, 2), InputError);
+  SurfaceOptions cesn;
+  cesn.method = Method::cesn;
+  v.inside[0] = 0;
+  EXPECT_THROW(chunked(v, 8, 2, cesn), UsageError);
+}
+
+}  // namespace
+}  // namespace voxpress
