@@ -17,16 +17,11 @@
 #include "voxpress/eval/truth.h"
 #include "voxpress/voxpress.h"
 
-namespace py = pybind11;
+#include "py_common.h"
+
 using namespace voxpress;
 
-namespace {
-
-// A mesh and the statistics of the call that made it.
-struct PyMesh {
-  Mesh mesh;
-  py::dict stats;
-};
+namespace voxpress::python {
 
 ScalarType scalar_type(const py::dtype& d) {
   const char kind = d.kind();
@@ -172,16 +167,38 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
   }
 }
 
+}  // namespace voxpress::python
+
+namespace {
+
+using namespace voxpress::python;
+
 PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py::object& origin, const py::object& direction,
              const std::string& method, const std::string& axes, const py::object& label, const py::object& threshold,
              const py::kwargs& kw) {
   SurfaceOptions o;
   o.method = parse_method(method);
-  set_options(o, kw);
+  py::kwargs rest;  // chunk= and halo= choose the chunked run; the others are SurfaceOptions
+  std::optional<ChunkOptions> chunks;
+  for (const auto& [key, value] : kw) {
+    const std::string k = py::str(key);
+    if (k == "chunk" && !value.is_none()) {
+      if (!chunks) chunks = ChunkOptions{};
+      chunks->chunk = value.cast<int64_t>();
+    } else if (k == "halo") {
+      if (!chunks) chunks = ChunkOptions{};
+      chunks->halo = value.cast<int64_t>();
+    } else if (k != "chunk") {
+      rest[key] = value;
+    }
+  }
+  if (chunks && !kw.contains("chunk")) throw UsageError("halo= needs chunk=");
+  set_options(o, rest);
   const Selection sel = selection(label, threshold);
   // ArrayLike: nested lists and anything numpy.asarray takes.
   const py::array mask = py::module_::import("numpy").attr("asarray")(mask_like);
   ScalarVolume scalar = to_volume(mask, spacing, origin, direction, axes);
+  if (chunks) return press_chunked_volume(scalar, sel, o, *chunks);  // flats off, as press --chunk
   SurfaceResult r;
   double seconds_binarize = 0;
   {
@@ -348,6 +365,7 @@ PYBIND11_MODULE(_voxpress, m) {
   m.doc() = "voxpress: smooth, accurate solids from binary voxel volumes (C++ core).";
   m.attr("__version__") = kVersion;
 
+  bind_chunks(m);
   static py::exception<Error> error(m, "Error", PyExc_RuntimeError);
   static py::exception<InputError> input_error(m, "InputError", error.ptr());
   static py::exception<UsageError> usage_error(m, "UsageError", error.ptr());

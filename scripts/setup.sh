@@ -16,7 +16,8 @@ packages=(build-essential cmake ninja-build pkg-config
           libtinygltf-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
           libgtest-dev libgmock-dev libbenchmark-dev libmeshoptimizer-dev nodejs
           python3-dev pybind11-dev python3-numpy)
-[ $with_tests = 1 ] && packages+=(python3-pytest python3-nibabel chromium)
+[ $with_tests = 1 ] && packages+=(python3-pytest python3-nibabel python3-dask python3-distributed python3-zarr chromium
+                                  clang libclang-rt-14-dev)
 
 missing=()
 for p in "${packages[@]}"; do

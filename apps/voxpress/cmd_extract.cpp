@@ -26,7 +26,7 @@ void run_extract(const ExtractCmd& c, const Global& g) {
   if (!g.quiet)
     std::fprintf(stderr, "%s: %zu vertices, %zu triangles\n", c.output.c_str(), mesh.vertex_count(), mesh.face_count());
   if (!c.stats_json.empty()) {
-    nlohmann::json j = surface_stats_json("extract", c.input, c.output, vs.volume, vs.stats, mesh);
+    nlohmann::json j = surface_stats_json("extract", c.input, c.output, vs.volume.lattice, vs.stats, mesh);
     j["seconds"] = {{"read", vs.seconds_read},
                     {"sticks", vs.stats.seconds_sticks},
                     {"triangles", vs.stats.seconds_triangles},

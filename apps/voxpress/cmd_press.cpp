@@ -1,6 +1,9 @@
 // voxpress press IN -o OUT: the volume's smooth surface by smooth_surface()
 // — Pressing with flats, junctions and sharp edges, or a baseline method.
+#include <tbb/parallel_for.h>
+
 #include <cstdio>
+#include <mutex>
 
 #include "common.h"
 
@@ -113,37 +116,60 @@ void write_features(const std::string& path, const Mesh& mesh) {
 }
 
 // press --chunk: block by block (chunk/chunked.h); flats and sharp edges off.
+// press --chunk: the file read block by block (VolumeFile streams raw NRRD
+// and .raw; other files are read whole first), an automatic selection
+// resolved on one pass over the blocks, and --check on slabs of planes.
 void run_press_chunked(const PressCmd& c, SurfaceOptions so, const Global& g) {
   if (so.method != Method::pressing) throw UsageError("--chunk runs --method pressing only");
   for (const char* name : {"--labels", "--features", "--color-regions", "--min-flat-area", "--junction-angle",
                            "--sharp-angle", "--no-sharpen"})
     if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --chunk (no flats across blocks yet)");
+  Selection selection = c.in.selection();  // usage errors before any I/O
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   so.progress = bar.get();
-  const BinaryVolume volume = load_binary(c.input, c.in, g);
+  const VolumeFile file(c.input, c.in.read_options(g));
+  const Lattice& lattice = file.header().lattice;
+  const ChunkGrid grid(lattice.dims, c.chunks);
+  if (selection.kind == Selection::Kind::automatic) {  // which value the mask holds: one pass over the blocks
+    ValueSummary values;
+    std::mutex mu;
+    ProgressCounter progress(so.progress, "values", grid.count());
+    tbb::parallel_for(size_t(0), grid.count(), [&](size_t b) {
+      const ValueSummary part = summarize_values(file.read(grid.core(b)));
+      std::lock_guard lock(mu);
+      values.merge(part);  // min, max, or and a set union: order-independent
+      progress.add(1);
+    });
+    selection = resolve_selection(file.header(), selection, values);
+  }
   const double seconds_read = clock.seconds();
-  const BlockReader read = [&](const Box& box) { return crop(volume, box); };
+  const BlockReader read = [&](const Box& box) { return select_samples(file.read(box), selection); };
   ChunkedStats st;
-  const Mesh mesh = press_chunked(volume.lattice, c.input, read, so, c.chunks, &st);
-  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), c.method, true) : nlohmann::json();
+  const Mesh mesh = press_chunked(lattice, c.input, read, so, c.chunks, &st);
+  const PlaneReader planes = [&](int64_t k0, int64_t k1) {
+    return read(Box{{0, 0, k0}, {lattice.dims[0], lattice.dims[1], k1}});
+  };
+  const nlohmann::json checks = c.check ? check_surface(mesh, lattice, planes, bar.get(), c.method) : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
   if (!g.quiet)
     std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu blocks of %lld (halo %lld, %zu with surface), %d levels, "
-                 "at most %d iterations; no flats (--chunk)\n",
+                 "at most %d iterations; no flats (--chunk)%s\n",
                  c.output.c_str(), mesh.vertex_count(), mesh.face_count(), st.blocks, (long long)c.chunks.chunk,
-                 (long long)c.chunks.halo, st.pressed, st.levels, st.max_iterations);
+                 (long long)c.chunks.halo, st.pressed, st.levels, st.max_iterations,
+                 file.streams() ? "" : "; the file was read whole (only raw NRRD and .raw stream)");
   if (!c.stats_json.empty()) {
     ExtractStats es;
-    es.samples = volume.lattice.size();
+    es.samples = lattice.size();
     es.sticks = st.sticks;
     es.triangles = st.triangles;
-    nlohmann::json j = surface_stats_json("press", c.input, c.output, volume, es, mesh);
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, lattice, es, mesh);
     j["method"] = c.method;
     j["chunks"] = {{"chunk", c.chunks.chunk}, {"halo", c.chunks.halo}, {"blocks", st.blocks},
-                   {"blocks_with_surface", st.pressed}, {"levels", st.levels}, {"max_iterations", st.max_iterations}};
+                   {"blocks_with_surface", st.pressed}, {"levels", st.levels}, {"max_iterations", st.max_iterations},
+                   {"streamed", file.streams()}};
     j["seconds"] = {{"read", seconds_read}, {"summary", st.seconds_summary}, {"blocks", st.seconds_blocks},
                     {"stitch", st.seconds_stitch}, {"total", clock.seconds()}};
     j["peak_memory_bytes"] = peak_rss_bytes();
@@ -236,7 +262,7 @@ void run_press(const PressCmd& c, const Global& g) {
                    checks["self_intersections"].get<size_t>(), c.method.c_str());
   }
   if (!c.stats_json.empty()) {
-    nlohmann::json j = surface_stats_json("press", c.input, c.output, volume, r.extract, mesh);
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, volume.lattice, r.extract, mesh);
     j["method"] = c.method;
     if (pressing) {
       j["pressing"] = press_stats_json(r.press, so.press);

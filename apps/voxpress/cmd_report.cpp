@@ -51,12 +51,12 @@ nlohmann::json append_raw(std::vector<uint8_t>& blob, const void* data, size_t b
   return {at, bytes};
 }
 
-struct Box {
+struct Bounds {
   Vec3 lo, hi;
 };
 
 // One mesh as the viewer's payload: manifest fields + base64 blob.
-nlohmann::json encode_mesh(const std::string& name, const Mesh& m, const Box& box,
+nlohmann::json encode_mesh(const std::string& name, const Mesh& m, const Bounds& box,
                            const std::vector<float>* error_vox) {
   const size_t nv = m.positions.size();
   std::vector<uint32_t> idx(m.triangles.size() * 3);
@@ -223,7 +223,7 @@ void run_report(const ReportCmd& c, const Global& g) {
     entries.push_back({m, std::move(mesh), s});
   }
 
-  Box box{Vec3::Constant(std::numeric_limits<double>::infinity()), Vec3::Constant(-std::numeric_limits<double>::infinity())};
+  Bounds box{Vec3::Constant(std::numeric_limits<double>::infinity()), Vec3::Constant(-std::numeric_limits<double>::infinity())};
   for (const Entry& e : entries)
     for (const Vec3& p : e.mesh.positions) box.lo = box.lo.cwiseMin(p), box.hi = box.hi.cwiseMax(p);
 

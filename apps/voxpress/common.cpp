@@ -132,12 +132,12 @@ VolumeSurface load_surface(const std::string& path, const InputOptions& in, cons
 }
 
 nlohmann::json surface_stats_json(const char* command, const std::string& input, const std::string& output,
-                                  const BinaryVolume& volume, const ExtractStats& extract, const Mesh& mesh) {
+                                  const Lattice& lattice, const ExtractStats& extract, const Mesh& mesh) {
   nlohmann::json j;
   j["command"] = command;
   j["input"] = input;
   j["output"] = output;
-  j["lattice"] = lattice_json(volume.lattice);
+  j["lattice"] = lattice_json(lattice);
   j["counts"] = {{"samples", extract.samples}, {"sticks", extract.sticks}, {"vertices", mesh.vertex_count()},
                  {"triangles", mesh.face_count()}};
   return j;
@@ -223,12 +223,9 @@ nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
           {"free_ends", o.free_ends}};
 }
 
-nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what,
-                             bool strict) {
-  const MeshCheck mc = check_mesh(mesh);
-  ClassificationOptions co;
-  co.progress = progress;
-  const ClassificationReport cr = check_classification(mesh, volume, co);
+namespace {
+
+nlohmann::json report_checks(const MeshCheck& mc, const ClassificationReport& cr, const std::string& what, bool strict) {
   if (strict && (!mc.ok() || cr.violations))
     throw Error("the " + what + " surface failed its checks: " +
                 (mc.problems.empty() ? std::to_string(cr.violations) + " classification violations" : mc.problems[0]));
@@ -239,6 +236,24 @@ nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progr
           {"self_intersections", mc.self_intersections},
           {"problems", mc.problems},
           {"classification_violations", cr.violations}};
+}
+
+}  // namespace
+
+nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what,
+                             bool strict) {
+  const MeshCheck mc = check_mesh(mesh);
+  ClassificationOptions co;
+  co.progress = progress;
+  return report_checks(mc, check_classification(mesh, volume, co), what, strict);
+}
+
+nlohmann::json check_surface(const Mesh& mesh, const Lattice& lattice, const PlaneReader& planes, Progress* progress,
+                             const std::string& what) {
+  const MeshCheck mc = check_mesh(mesh);
+  ClassificationOptions co;
+  co.progress = progress;
+  return report_checks(mc, check_classification(mesh, lattice, planes, co), what, true);
 }
 
 void PlacementCli::bind(CLI::App& cmd, const std::string& what) {

@@ -74,7 +74,7 @@ VolumeSurface load_surface(const std::string& path, const InputOptions& in, cons
 /// The --stats-json fields `extract` and `press` share: command, input,
 /// output, lattice and counts.
 nlohmann::json surface_stats_json(const char* command, const std::string& input, const std::string& output,
-                                  const BinaryVolume& volume, const ExtractStats& extract, const Mesh& mesh);
+                                  const Lattice& lattice, const ExtractStats& extract, const Mesh& mesh);
 
 /// Parses "a,b,c" into a Vec3 (for --spacing, --raw-spacing, ...).
 Vec3 parse_vec3(const std::string& text, const std::string& option);
@@ -106,6 +106,9 @@ nlohmann::json smooth_stats_json(const SmoothStats& st);
 /// failure; returns the "checks" object for --stats-json.
 nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progress* progress, const std::string& what,
                              bool strict = true);
+/// The same with the volume read a slab of planes at a time (press --chunk).
+nlohmann::json check_surface(const Mesh& mesh, const Lattice& lattice, const PlaneReader& planes, Progress* progress,
+                             const std::string& what);
 
 /// --res --rotate --spacing --margin: how generate and voxelize place a solid
 /// on a new lattice (GenerateOptions and VoxelizeOptions share these fields).

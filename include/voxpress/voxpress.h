@@ -14,6 +14,7 @@
 #include "voxpress/io/atomic_file.h"
 #include "voxpress/io/image_io.h"
 #include "voxpress/io/mesh_io.h"
+#include "voxpress/io/volume_file.h"
 #include "voxpress/io/volume_io.h"
 #include "voxpress/render/render.h"
 #include "voxpress/features/flats.h"

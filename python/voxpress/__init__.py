@@ -12,6 +12,7 @@ See voxpress/__init__.pyi for the signatures.
 from . import _voxpress
 from ._voxpress import (  # noqa: F401
     Error,
+    chunk_plan,
     InputError,
     Lattice,
     LimitError,
@@ -28,7 +29,7 @@ from ._voxpress import (  # noqa: F401
 def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, method="pressing",
           axes="xyz", label=None, threshold=None, iterations=None, tolerance=None, flats=None, sharpen=None,
           min_flat_area=None, junction_angle=None, sharp_angle=None, disable_passes=None, color_regions=None,
-          fit_rings=None, lambda_=None, mu=None):
+          fit_rings=None, lambda_=None, mu=None, chunk=None, halo=None):
     """The smooth surface of a 3-D mask, as `voxpress press` computes it; returns a Mesh.
 
     mask: bool, integer-label or float array (anything numpy.asarray takes);
@@ -49,6 +50,8 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
       disable_passes  names of feature-layer passes to switch off, e.g.
                      ["curved-creases"] (the list: voxpress press --help)
       lambda_, mu  Taubin / Laplacian steps
+      chunk, halo  press block by block, as `press --chunk N --halo H` (flats
+                   off; halo 24 by default); voxpress.dask runs the blocks on Dask
     Out-of-range values raise UsageError with the command line's message; the
     GIL is released while it works.
     """
@@ -56,7 +59,7 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
                    min_flat_area=min_flat_area, junction_angle=junction_angle, sharp_angle=sharp_angle,
                    disable_passes=None if disable_passes is None else list(disable_passes),
                    color_regions=color_regions, fit_rings=fit_rings,
-                   lambda_=lambda_, mu=mu)
+                   lambda_=lambda_, mu=mu, chunk=chunk, halo=halo)
     return _voxpress.press(mask, spacing=spacing, origin=origin, direction=direction, method=method, axes=axes,
                            label=label, threshold=threshold,
                            **{k: v for k, v in options.items() if v is not None})
@@ -82,4 +85,4 @@ def press_labels(array, labels=None, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
 
 
 __all__ = ["Error", "InputError", "LimitError", "UsageError", "Lattice", "Mesh", "press", "press_labels", "read_volume",
-           "read_mesh", "check", "evaluate", "__version__"]
+           "read_mesh", "check", "evaluate", "chunk_plan", "__version__"]

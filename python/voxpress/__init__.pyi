@@ -72,6 +72,8 @@ def press(
     color_regions: bool = False,
     lambda_: float = ...,
     mu: float = ...,
+    chunk: Optional[int] = None,
+    halo: int = 24,
 ) -> Mesh:
     """The smooth surface of a 3-D mask, as `voxpress press` computes it.
 
@@ -85,6 +87,10 @@ def press(
     unchanged with axes="zyx". direction: 3 x 3, column a = physical
     direction of index axis a. The GIL is released while it works.
     """
+
+def chunk_plan(shape: Sequence[int], *, chunk: int = 256, halo: int = 24) -> list[dict[str, Any]]:
+    """The blocks of a volume, x fastest: [{"block": b, "core": (lo, hi), "read": (lo, hi)}] (voxpress.dask)."""
+    ...
 
 def press_labels(
     array: npt.ArrayLike,

@@ -109,9 +109,7 @@ void VolumeSummary::merge(const VolumeSummary& o) {
 
 BinaryVolume crop(const BinaryVolume& v, const Box& box) {
   BinaryVolume out;
-  out.lattice = v.lattice;
-  out.lattice.dims = box.dims();
-  out.lattice.origin = v.lattice.to_physical(Vec3(double(box.lo[0]), double(box.lo[1]), double(box.lo[2])));
+  out.lattice = box_lattice(v.lattice, box);
   out.source = v.source;
   out.inside.resize(box.size());
   const int64_t nx = box.hi[0] - box.lo[0];
@@ -321,9 +319,7 @@ Mesh press_chunked(const Lattice& lattice, const std::string& source, const Bloc
         BinaryVolume block = read(box);
         if (block.lattice.dims != box.dims() || block.inside.size() != box.size())
           throw std::logic_error("press_chunked: the reader returned the wrong box");
-        block.lattice = lattice;
-        block.lattice.dims = box.dims();
-        block.lattice.origin = lattice.to_physical(Vec3(double(box.lo[0]), double(box.lo[1]), double(box.lo[2])));
+        block.lattice = box_lattice(lattice, box);
         block.source = source;
         pieces[b] = press_block(block, grid, b, so);
         progress.add(1);

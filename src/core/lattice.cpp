@@ -41,4 +41,11 @@ void Lattice::validate() const {
     throw UsageError("lattice direction matrix is singular or not finite");
 }
 
+Lattice box_lattice(const Lattice& volume, const Box& box) {
+  Lattice l = volume;
+  l.dims = box.dims();
+  l.origin = volume.to_physical(Vec3(double(box.lo[0]), double(box.lo[1]), double(box.lo[2])));
+  return l;
+}
+
 }  // namespace voxpress

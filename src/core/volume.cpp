@@ -82,40 +82,6 @@ std::string format_value(double v) {
 
 namespace {
 
-// First non-zero value and whether another, different non-zero value exists.
-struct NonzeroSummary {
-  bool any = false;
-  double first = 0;
-  bool several = false;
-  bool fractional = false;  // some value is not an integer
-  double lo = 0, hi = 0;
-};
-
-NonzeroSummary summarize(const ScalarVolume& v, int64_t component, int64_t stride) {
-  return v.visit([&](auto values) {
-    NonzeroSummary s;
-    bool init = false;
-    for (uint64_t n = uint64_t(component); n < values.size(); n += uint64_t(stride)) {
-      const double x = double(values[n]);
-      if (!init) {
-        s.lo = s.hi = x;
-        init = true;
-      }
-      s.lo = std::min(s.lo, x);
-      s.hi = std::max(s.hi, x);
-      if (x != std::floor(x)) s.fractional = true;
-      if (x == 0) continue;
-      if (!s.any) {
-        s.any = true;
-        s.first = x;
-      } else if (x != s.first) {
-        s.several = true;
-      }
-    }
-    return s;
-  });
-}
-
 template <class Pred>
 BinaryVolume select(const ScalarVolume& v, int64_t component, Pred pred) {
   BinaryVolume b;
@@ -145,16 +111,89 @@ BinaryVolume select_any_component(const ScalarVolume& v, Pred pred) {
 
 }  // namespace
 
-BinaryVolume binarize(const ScalarVolume& v, const Selection& sel) {
+void ValueSummary::add(double x) {
+  lo = std::min(lo, x);
+  hi = std::max(hi, x);
+  if (x != std::floor(x)) fractional = true;
+  if (x == 0 || more) return;
+  auto it = std::lower_bound(nonzero.begin(), nonzero.end(), x);
+  if (it != nonzero.end() && *it == x) return;
+  if (nonzero.size() == kMaxDistinct) {
+    more = true;
+    nonzero.clear();  // which values were seen first depends on the order of blocks: keep none
+    return;
+  }
+  nonzero.insert(it, x);
+}
+
+void ValueSummary::merge(const ValueSummary& o) {
+  lo = std::min(lo, o.lo);
+  hi = std::max(hi, o.hi);
+  fractional |= o.fractional;
+  for (double x : o.nonzero) add(x);
+  if (o.more) {
+    more = true;
+    nonzero.clear();
+  }
+}
+
+ValueSummary summarize_values(const ScalarVolume& v) {
+  return v.visit([&](auto values) {
+    ValueSummary s;
+    bool first = true;
+    double last = 0;
+    for (const auto value : values) {
+      const double x = double(value);
+      if (!first && (x == last)) continue;  // runs of one value: the common case of masks and label maps
+      first = false;
+      last = x;
+      s.add(x);
+    }
+    return s;
+  });
+}
+
+Selection resolve_selection(const ScalarVolume& v, const Selection& sel, const ValueSummary& values) {
+  using K = Selection::Kind;
+  if (sel.kind != K::automatic) return sel;
+  // Automatic: a mask with a single non-zero value is unambiguous.
+  if (v.segments.size() == 1) {
+    Selection s;
+    s.kind = K::segment;
+    s.segment = v.segments[0].id.empty() ? v.segments[0].name : v.segments[0].id;
+    return s;
+  }
+  if (v.segments.size() > 1) {
+    std::string names;
+    for (const Segment& s : v.segments) names += (names.empty() ? "" : ", ") + s.name;
+    throw InputError(v.source, "segmentation with " + std::to_string(v.segments.size()) + " segments (" + names +
+                                   "); choose one with --segment NAME or --label N");
+  }
+  if (values.fractional)
+    throw InputError(v.source, std::string("grey-level volume (") + scalar_name(v.type) + ", values " +
+                                   format_value(values.lo) + " .. " + format_value(values.hi) +
+                                   "); choose an iso-level with --threshold T");
+  if (values.more)
+    throw InputError(v.source, "volume with many distinct values; choose --label N, --label all-nonzero or --threshold T");
+  if (values.nonzero.size() > 1) {
+    std::string labels;
+    for (size_t i = 0; i < values.nonzero.size() && i < 8; ++i) labels += (i ? ", " : "") + format_value(values.nonzero[i]);
+    if (values.nonzero.size() > 8) labels += ", ...";
+    throw InputError(v.source, "label map with " + std::to_string(values.nonzero.size()) + " labels (" + labels +
+                                   "); choose one with --label N or --label all-nonzero");
+  }
+  Selection s;
+  s.kind = K::nonzero;
+  return s;
+}
+
+BinaryVolume select_samples(const ScalarVolume& v, const Selection& sel) {
   using K = Selection::Kind;
   switch (sel.kind) {
     case K::label: {
       const double label = sel.value;
       if (!std::isfinite(label)) throw UsageError("the label must be a finite number, not " + format_value(label));
-      BinaryVolume b = select_any_component(v, [label](double x) { return x == label; });
-      if (b.count_inside() == 0)
-        throw InputError(v.source, "no sample has label " + format_value(label) + " (see `voxpress info`)");
-      return b;
+      return select_any_component(v, [label](double x) { return x == label; });
     }
     case K::nonzero: return select_any_component(v, [](double x) { return x != 0; });
     case K::threshold: {
@@ -179,53 +218,15 @@ BinaryVolume binarize(const ScalarVolume& v, const Selection& sel) {
     }
     case K::automatic: break;
   }
-  // Automatic: a mask with a single non-zero value is unambiguous.
-  if (v.segments.size() == 1) {
-    Selection s;
-    s.kind = K::segment;
-    s.segment = v.segments[0].id.empty() ? v.segments[0].name : v.segments[0].id;
-    return binarize(v, s);
-  }
-  if (v.segments.size() > 1) {
-    std::string names;
-    for (const Segment& s : v.segments) names += (names.empty() ? "" : ", ") + s.name;
-    throw InputError(v.source, "segmentation with " + std::to_string(v.segments.size()) + " segments (" + names +
-                                   "); choose one with --segment NAME or --label N");
-  }
-  NonzeroSummary total;
-  for (int64_t c = 0; c < v.components; ++c) {
-    NonzeroSummary s = summarize(v, c, v.components);
-    if (c == 0) {
-      total = s;
-    } else {
-      total.several |= s.several || (s.any && total.any && s.first != total.first);
-      total.fractional |= s.fractional;
-      if (!total.any) total.first = s.first;
-      total.any |= s.any;
-    }
-  }
-  if (total.fractional)
-    throw InputError(v.source, std::string("grey-level volume (") + scalar_name(v.type) + ", values " +
-                                   format_value(total.lo) + " .. " + format_value(total.hi) +
-                                   "); choose an iso-level with --threshold T");
-  if (total.several) {
-    auto hist = value_histogram(v, 64);
-    std::string labels;
-    size_t count = 0;
-    if (hist) {
-      for (auto& [value, n] : *hist)
-        if (value != 0) {
-          if (count < 8) labels += (labels.empty() ? "" : ", ") + format_value(value);
-          ++count;
-        }
-      if (count > 8) labels += ", ...";
-    }
-    throw InputError(v.source, hist ? "label map with " + std::to_string(count) + " labels (" + labels +
-                                          "); choose one with --label N or --label all-nonzero"
-                                    : std::string("volume with many distinct values; choose --label N, "
-                                                  "--label all-nonzero or --threshold T"));
-  }
-  return select_any_component(v, [](double x) { return x != 0; });
+  throw UsageError("select_samples: resolve an automatic selection first (resolve_selection)");
+}
+
+BinaryVolume binarize(const ScalarVolume& v, const Selection& sel) {
+  const Selection s = sel.kind == Selection::Kind::automatic ? resolve_selection(v, sel, summarize_values(v)) : sel;
+  BinaryVolume b = select_samples(v, s);
+  if (s.kind == Selection::Kind::label && b.count_inside() == 0)
+    throw InputError(v.source, "no sample has label " + format_value(s.value) + " (see `voxpress info`)");
+  return b;
 }
 
 std::optional<std::vector<std::pair<double, uint64_t>>> value_histogram(const ScalarVolume& v, size_t max_distinct) {

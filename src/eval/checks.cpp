@@ -251,23 +251,18 @@ MeshCheck check_mesh(const Mesh& mesh, const MeshCheckOptions& options) {
 }
 
 // ---------------------------------------------------------------------------
-ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& volume,
-                                          const ClassificationOptions& options) {
-  ClassificationReport rep;
-  const Lattice& L = volume.lattice;
-  const int64_t pad = options.include_padding ? 1 : 0;
-  const std::array<int64_t, 3> lo{-pad, -pad, -pad};
-  const std::array<int64_t, 3> hi{L.dims[0] - 1 + pad, L.dims[1] - 1 + pad, L.dims[2] - 1 + pad};
-  const Mat3 inv = L.index_to_physical_matrix().inverse();
-  std::vector<Vec3> V(mesh.positions.size());
-  for (size_t v = 0; v < V.size(); ++v) V[v] = inv * (mesh.positions[v] - L.origin);
-  const detail::RowRays rays(std::move(V), mesh.triangles, lo, hi, L.flips_orientation());
+namespace {
 
-  std::atomic<uint64_t> in_out{0}, out_in{0}, on{0};
-  std::mutex m;
-  std::vector<std::array<int64_t, 3>> examples;
-  ProgressCounter progress(options.progress, "classification", uint64_t(hi[2] - lo[2] + 1));
-  tbb::parallel_for(lo[2], hi[2] + 1, [&](int64_t k) {
+// Planes of samples a streamed check holds at once (a few tens of MB at 1024^2).
+constexpr uint64_t kSlabSamples = uint64_t(32) << 20;
+
+// The rows of planes [k0, k1) (padded indices allowed) against rays; `slab`
+// holds the volume's planes from slab_k0 (samples beyond it are outside).
+void classify_planes(const detail::RowRays& rays, const ClassificationOptions& options, const std::array<int64_t, 3>& lo,
+                     const std::array<int64_t, 3>& hi, int64_t k0, int64_t k1, const BinaryVolume& slab,
+                     int64_t slab_k0, ProgressCounter& progress, std::atomic<uint64_t>* tally, std::mutex& m,
+                     std::vector<std::array<int64_t, 3>>& examples) {
+  tbb::parallel_for(k0, k1, [&](int64_t k) {
     std::vector<int> winding;
     std::vector<uint8_t> odd;
     std::vector<int64_t> on_surface;
@@ -284,7 +279,7 @@ ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& 
         } else {
           const size_t x = size_t(i - lo[0]);
           const bool inside = options.rule == ClassificationOptions::Rule::winding ? winding[x] > 0 : odd[x] != 0;
-          const bool expected = volume.at(i, j, k);
+          const bool expected = slab.at(i, j, k - slab_k0);
           if (inside != expected) kind = expected ? 0 : 1;
         }
         if (kind >= 0) {
@@ -293,19 +288,43 @@ ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& 
         }
       }
     }
-    in_out += local[0];
-    out_in += local[1];
-    on += local[2];
+    for (int c = 0; c < 3; ++c) tally[c] += local[c];
     if (!local_ex.empty()) {
       std::lock_guard lock(m);
       examples.insert(examples.end(), local_ex.begin(), local_ex.end());
     }
     progress.add(1);
   });
+}
+
+// Both forms: `slab_of(k0, k1)` returns the volume's planes [k0, k1) (k0 is
+// where the returned volume starts) for the in-volume planes.
+ClassificationReport classify(const Mesh& mesh, const Lattice& L, const ClassificationOptions& options, int64_t slab,
+                              const std::function<const BinaryVolume&(int64_t k0, int64_t k1)>& slab_of) {
+  ClassificationReport rep;
+  const int64_t pad = options.include_padding ? 1 : 0;
+  const std::array<int64_t, 3> lo{-pad, -pad, -pad};
+  const std::array<int64_t, 3> hi{L.dims[0] - 1 + pad, L.dims[1] - 1 + pad, L.dims[2] - 1 + pad};
+  const Mat3 inv = L.index_to_physical_matrix().inverse();
+  std::vector<Vec3> V(mesh.positions.size());
+  for (size_t v = 0; v < V.size(); ++v) V[v] = inv * (mesh.positions[v] - L.origin);
+  const detail::RowRays rays(std::move(V), mesh.triangles, lo, hi, L.flips_orientation());
+
+  std::atomic<uint64_t> tally[3] = {0, 0, 0};  // inside found outside, outside found inside, on the surface
+  std::mutex m;
+  std::vector<std::array<int64_t, 3>> examples;
+  ProgressCounter progress(options.progress, "classification", uint64_t(hi[2] - lo[2] + 1));
+  const BinaryVolume none;  // the padding planes: every sample outside
+  if (pad) classify_planes(rays, options, lo, hi, -1, 0, none, 0, progress, tally, m, examples);
+  for (int64_t k0 = 0; k0 < L.dims[2]; k0 += slab) {
+    const int64_t k1 = std::min(L.dims[2], k0 + slab);
+    classify_planes(rays, options, lo, hi, k0, k1, slab_of(k0, k1), k0, progress, tally, m, examples);
+  }
+  if (pad) classify_planes(rays, options, lo, hi, L.dims[2], L.dims[2] + 1, none, 0, progress, tally, m, examples);
   rep.samples = uint64_t(hi[0] - lo[0] + 1) * uint64_t(hi[1] - lo[1] + 1) * uint64_t(hi[2] - lo[2] + 1);
-  rep.inside_found_outside = in_out;
-  rep.outside_found_inside = out_in;
-  rep.on_surface = on;
+  rep.inside_found_outside = tally[0];
+  rep.outside_found_inside = tally[1];
+  rep.on_surface = tally[2];
   rep.violations = rep.inside_found_outside + rep.outside_found_inside + rep.on_surface;
   std::sort(examples.begin(), examples.end(), [](const auto& x, const auto& y) {
     return std::tie(x[2], x[1], x[0]) < std::tie(y[2], y[1], y[0]);
@@ -313,6 +332,29 @@ ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& 
   if (examples.size() > options.max_examples) examples.resize(options.max_examples);
   rep.examples = examples;
   return rep;
+}
+
+}  // namespace
+
+ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& volume,
+                                          const ClassificationOptions& options) {
+  // One slab: the whole volume, read in place.
+  const int64_t nz = std::max<int64_t>(volume.lattice.dims[2], 1);
+  return classify(mesh, volume.lattice, options, nz, [&](int64_t, int64_t) -> const BinaryVolume& { return volume; });
+}
+
+ClassificationReport check_classification(const Mesh& mesh, const Lattice& lattice, const PlaneReader& read,
+                                          const ClassificationOptions& options, int64_t slab) {
+  const uint64_t plane = std::max<uint64_t>(uint64_t(lattice.dims[0]) * uint64_t(lattice.dims[1]), 1);
+  if (slab <= 0) slab = int64_t(std::max<uint64_t>(kSlabSamples / plane, 1));
+  BinaryVolume current;
+  return classify(mesh, lattice, options, slab, [&](int64_t k0, int64_t k1) -> const BinaryVolume& {
+    current = read(k0, k1);
+    if (current.lattice.dims != std::array<int64_t, 3>{lattice.dims[0], lattice.dims[1], k1 - k0} ||
+        current.inside.size() != current.lattice.size())
+      throw std::logic_error("check_classification: the plane reader returned the wrong planes");
+    return current;
+  });
 }
 
 }  // namespace voxpress

@@ -178,7 +178,7 @@ std::string nrrd_type_name(ScalarType t) {
 
 }  // namespace
 
-ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes) {
+ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* raw) {
   const Header h = parse_header(path);
   ScalarVolume v;
   v.source = path;
@@ -287,7 +287,7 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes) {
   const size_t vs = scalar_size(v.type);
   const uint64_t count = checked_count(path, v.lattice.dims, v.components, vs);
   const uint64_t bytes = count * vs;
-  check_limit(path, bytes, max_bytes, "the volume");
+  if (!raw) check_limit(path, bytes, max_bytes, "the volume");  // streamed, it is read block by block
   const std::string enc = lower(*encoding);
   bool big = false;
   if (const auto* e = field(h, {"endian"})) big = lower(*e) == "big";
@@ -330,11 +330,13 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes) {
     return off;
   };
 
-  v.bytes.resize(bytes);
+  if (raw) raw->parts.clear();
+  if (raw && enc != "raw") return v;  // compressed or text: no box can be read without the rest
   if (enc == "raw") {
     if (files.size() > 1 && bytes % files.size()) throw InputError(path, "LIST files cannot split the data evenly");
     const uint64_t per_file = bytes / std::max<size_t>(files.size(), 1);
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
+    std::vector<RawPayload::Part> parts;
     for (size_t f = 0; f < sources.size(); ++f) {
       const std::string& file = sources[f];
       const uint64_t fsize = file_size(file);
@@ -352,9 +354,18 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes) {
       if (avail > per_file && byte_skip != -1)
         throw InputError(file, "the data size does not match the header: " + std::to_string(avail) +
                                    " bytes present, " + std::to_string(per_file) + " declared by sizes and type");
-      read_range_into(file, off, v.bytes.data() + f * per_file, per_file);
+      parts.push_back({file, off, per_file});
     }
+    if (raw) {
+      raw->parts = std::move(parts);
+      raw->big_endian = big && vs > 1;
+      return v;
+    }
+    v.bytes.resize(bytes);
+    for (size_t f = 0; f < parts.size(); ++f)
+      read_range_into(parts[f].file, parts[f].offset, v.bytes.data() + f * per_file, per_file);
   } else if (enc == "gzip" || enc == "gz") {
+    v.bytes.resize(bytes);
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
     std::vector<std::byte> compressed;
     for (const auto& file : sources) {
@@ -367,6 +378,7 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes) {
     }
     inflate_exact(path, compressed.data(), compressed.size(), v.bytes.data(), bytes);
   } else if (enc == "text" || enc == "txt" || enc == "ascii") {
+    v.bytes.resize(bytes);
     std::string text;
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
     for (const auto& file : sources) {

@@ -66,7 +66,7 @@ ScalarType parse_scalar_type(const std::string& name) {
 
 namespace detail {
 
-ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t max_bytes) {
+ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t max_bytes, RawPayload* raw) {
   ScalarVolume v;
   v.source = path;
   v.type = layout.type;
@@ -80,7 +80,7 @@ ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t
   }
   const size_t vs = scalar_size(v.type);
   const uint64_t count = checked_count(path, v.lattice.dims, 1, vs);
-  check_limit(path, count * vs, max_bytes, "the volume");
+  if (!raw) check_limit(path, count * vs, max_bytes, "the volume");
   const uint64_t fs = file_size(path);
   const uint64_t need = layout.header_bytes + count * vs;
   if (fs < need)
@@ -89,6 +89,11 @@ ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t
   if (fs > need)
     throw InputError(path, "the file size does not match the raw layout: " + std::to_string(fs) + " bytes, " +
                                std::to_string(need) + " expected (check the dimensions, type and header bytes)");
+  if (raw) {
+    raw->parts = {{path, layout.header_bytes, count * vs}};
+    raw->big_endian = layout.big_endian && vs > 1;
+    return v;
+  }
   v.bytes.resize(count * vs);
   read_range_into(path, layout.header_bytes, v.bytes.data(), count * vs);
   if (layout.big_endian) swap_bytes(v.bytes.data(), count, vs);

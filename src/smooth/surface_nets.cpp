@@ -33,7 +33,7 @@ constexpr int kSlotOffset[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 
 Vec3 index_vec(const std::array<int64_t, 3>& i) { return {double(i[0]), double(i[1]), double(i[2])}; }
 
-struct Box {
+struct Bounds {
   Vec3 lo, hi;
 };
 
@@ -69,7 +69,7 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
   // Patches: connected triangles of one cell (union-find over its <= 12 sticks).
   std::vector<uint32_t> stick_patch(4 * ns, kNone);
   std::vector<Vec3> x;       // net vertex positions, index space (unpadded)
-  std::vector<Box> box;      // their constraint boxes
+  std::vector<Bounds> box;      // their constraint boxes
   for (size_t g = 0; g < by_cell.size();) {
     size_t e = g;
     while (e < by_cell.size() && by_cell[e].first == by_cell[g].first) ++e;

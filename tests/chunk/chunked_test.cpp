@@ -160,6 +160,28 @@ TEST(Chunked, SameBytesForAnyThreadCountAndPieceOrder) {
   EXPECT_THROW(stitch(s.volume.lattice, pieces), std::logic_error);
 }
 
+TEST(Chunked, ClassificationBySlabsReportsWhatTheWholeVolumeCheckDoes) {
+  // press --chunk --check classifies slabs of planes: every slab size gives
+  // the in-memory report, violations included (a pushed-in vertex here).
+  Rng rng(3);
+  const BinaryVolume v = test::random_blobs(rng, {26, 21, 23}, 4);
+  Mesh m = whole(v);
+  for (size_t i = 0; i < m.positions.size(); i += 97) m.positions[i] += Vec3(0.9, -0.8, 0.7);
+  const ClassificationReport ref = check_classification(m, v);
+  ASSERT_GT(ref.violations, 0u);
+  const PlaneReader planes = [&](int64_t k0, int64_t k1) {
+    return crop(v, Box{{0, 0, k0}, {v.lattice.dims[0], v.lattice.dims[1], k1}});
+  };
+  for (int64_t slab : {1, 4, 7, 23, 0}) {
+    const ClassificationReport r = check_classification(m, v.lattice, planes, {}, slab);
+    EXPECT_EQ(r.samples, ref.samples);
+    EXPECT_EQ(r.inside_found_outside, ref.inside_found_outside);
+    EXPECT_EQ(r.outside_found_inside, ref.outside_found_inside);
+    EXPECT_EQ(r.on_surface, ref.on_surface);
+    EXPECT_EQ(r.examples, ref.examples);
+  }
+}
+
 TEST(Chunked, EmptyAndFullVolumesAreRefused) {
   BinaryVolume v = test::make_volume(20, 20, 20);
   EXPECT_THROW(chunked(v, 8, 2), InputError);

@@ -35,13 +35,6 @@
 
 namespace voxpress {
 
-/// A box of samples [lo, hi) per axis.
-struct Box {
-  std::array<int64_t, 3> lo{}, hi{};
-  uint64_t size() const { return uint64_t(hi[0] - lo[0]) * uint64_t(hi[1] - lo[1]) * uint64_t(hi[2] - lo[2]); }
-  std::array<int64_t, 3> dims() const { return {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}; }
-};
-
 struct ChunkOptions {
   int64_t chunk = 256;  ///< block side, samples (>= 8)
   /// Samples read beyond the block on every side (>= 1): enough for

@@ -28,6 +28,13 @@ enum class Space : uint8_t {
 };
 const char* space_name(Space s);
 
+/// A box of samples [lo, hi) per axis (a block of a volume).
+struct Box {
+  std::array<int64_t, 3> lo{}, hi{};
+  uint64_t size() const { return uint64_t(hi[0] - lo[0]) * uint64_t(hi[1] - lo[1]) * uint64_t(hi[2] - lo[2]); }
+  std::array<int64_t, 3> dims() const { return {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}; }
+};
+
 struct Lattice {
   std::array<int64_t, 3> dims{0, 0, 0};  ///< samples along i, j, k (each >= 1 when valid)
   Vec3 spacing{1, 1, 1};                 ///< cell size along i, j, k, physical units, > 0
@@ -53,5 +60,9 @@ struct Lattice {
   /// Throws UsageError unless dims >= 1, spacing finite and > 0, the matrix invertible.
   void validate() const;
 };
+
+/// The lattice of a box of samples of `volume`: its spacing, direction and
+/// space, the box's dims, the origin at the box's first sample.
+Lattice box_lattice(const Lattice& volume, const Box& box);
 
 }  // namespace voxpress

@@ -5,6 +5,7 @@
 // byte order. binarize() turns it into the BinaryVolume every method works on.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -90,6 +91,30 @@ std::string format_value(double v);
 
 /// Parses the CLI forms "N", "all-nonzero" (label) and "T" (threshold).
 Selection parse_label_selection(const std::string& text);
+
+/// What automatic selection needs of a volume's values: their range, whether
+/// one is fractional, and its distinct non-zero values (up to kMaxDistinct;
+/// past that `more`, and none kept). Blocks of a volume summarise apart and
+/// merge into the whole volume's summary.
+struct ValueSummary {
+  static constexpr size_t kMaxDistinct = 64;  // past this a volume is "many distinct values", not a label map
+  double lo = INFINITY, hi = -INFINITY;
+  bool fractional = false, more = false;
+  std::vector<double> nonzero;  ///< increasing
+  void add(double x);
+  void merge(const ValueSummary& other);
+};
+ValueSummary summarize_values(const ScalarVolume& volume);
+
+/// The concrete selection an automatic one stands for on a volume with these
+/// values (its one segment, or its one non-zero value); a non-automatic
+/// selection unchanged. Throws InputError (naming volume.source) when the
+/// choice is ambiguous: a grey volume, a label map, several segments.
+Selection resolve_selection(const ScalarVolume& volume, const Selection& selection, const ValueSummary& values);
+
+/// The samples a resolved selection picks (none is not an error: blocks of a
+/// volume may hold none). Throws UsageError for an automatic selection.
+BinaryVolume select_samples(const ScalarVolume& volume, const Selection& selection);
 
 /// Turns a scalar volume into a binary one. Throws InputError (naming
 /// volume.source) when the selection does not apply: no such label, an

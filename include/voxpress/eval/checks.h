@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -78,5 +79,14 @@ struct ClassificationReport {
 /// along lattice rows, symbolically perturbed off vertices and edges.
 ClassificationReport check_classification(const Mesh& mesh, const BinaryVolume& volume,
                                           const ClassificationOptions& options = {});
+
+/// Planes [k0, k1) of a volume as a BinaryVolume of dims (nx, ny, k1 - k0).
+using PlaneReader = std::function<BinaryVolume(int64_t k0, int64_t k1)>;
+
+/// The same check on a volume too large to hold: `lattice` is the whole
+/// volume's, its planes are read `slab` at a time (0: as many as make ~32 M
+/// samples). Same report, sample for sample, as the in-memory check.
+ClassificationReport check_classification(const Mesh& mesh, const Lattice& lattice, const PlaneReader& read,
+                                          const ClassificationOptions& options = {}, int64_t slab = 0);
 
 }  // namespace voxpress

@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""Seams of the chunked run (issue 56): `press --chunk C --halo H` against the
+whole-volume `press --no-flats` of the same volume, per block size and halo
+width. Prints one markdown row per run: topology the same (faces identical),
+max and RMS vertex distance in cells, `--check` (closed, manifold, oriented,
+no self-intersection, 0 violations), wall time and peak RSS of the process.
+
+    VOXPRESS_CLI=build/bin/voxpress PYTHONPATH=build/python \
+        python3 bench/chunk_seams.py [--chunks 64,128] [--halos 8,16,24,32] [--threads 2]
+
+Inputs: a rotated sphere and the CAD part generated at 256^3, and
+totalseg_heart from ../shared/data tiled (mirrored, so the copies join) to
+512^3; the heart is skipped with a message where ../shared is absent.
+"""
+import argparse
+import os
+import pathlib
+import re
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+root = pathlib.Path(__file__).resolve().parent.parent
+cli = os.environ.get("VOXPRESS_CLI", str(root / "build/bin/voxpress"))
+heart = root.parent / "shared/data/medical/totalseg_heart.nii.gz"
+
+
+def run(args):
+    """Runs the CLI under /usr/bin/time; returns (stdout+stderr, seconds, peak RSS MB)."""
+    p = subprocess.run(["/usr/bin/time", "-f", "TIME %e %M", cli, *args], capture_output=True, text=True)
+    out = p.stdout + p.stderr
+    if p.returncode != 0:
+        sys.exit(f"failed: {' '.join(args)}\n{out}")
+    m = re.search(r"TIME ([0-9.]+) ([0-9]+)", out)
+    return out, float(m.group(1)), int(m.group(2)) / 1024
+
+
+def read_ply(path):
+    """Vertices (float64) and faces of a binary little-endian PLY as voxpress writes it."""
+    b = pathlib.Path(path).read_bytes()
+    i = b.index(b"end_header\n") + len(b"end_header\n")
+    head = b[:i].decode().split("\n")
+    nv = int(next(l for l in head if l.startswith("element vertex")).split()[2])
+    nf = int(next(l for l in head if l.startswith("element face")).split()[2])
+    vtype = "<f8" if "property double x" in head else "<f4"
+    v = np.frombuffer(b, dtype=vtype, count=nv * 3, offset=i).reshape(-1, 3).astype(np.float64)
+    f = np.frombuffer(b, dtype=np.dtype([("n", "u1"), ("i", "<i4", 3)]), count=nf, offset=i + nv * 3 * np.dtype(vtype).itemsize)
+    return v, f["i"]
+
+
+def write_nrrd(path, mask):
+    """A raw uint8 NRRD of a [i, j, k] mask (x fastest on disk)."""
+    with open(path, "wb") as f:
+        f.write(f"NRRD0004\ntype: uint8\ndimension: 3\nsizes: {mask.shape[0]} {mask.shape[1]} {mask.shape[2]}\n"
+                "encoding: raw\nendian: little\n\n".encode())
+        f.write(np.ascontiguousarray(mask.astype(np.uint8).transpose(2, 1, 0)).tobytes())
+
+
+def tiled_heart(path, n):
+    import voxpress
+    a, _ = voxpress.read_volume(str(heart))
+    m = a != 0
+    lo = np.argwhere(m).min(0)
+    hi = np.argwhere(m).max(0) + 1
+    m = m[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
+    reps = [-(-n // s) + 1 for s in m.shape]
+    t = np.pad(m, [(0, (r - 1) * s) for r, s in zip(reps, m.shape)], mode="symmetric")[:n - 2, :n - 2, :n - 2]
+    write_nrrd(path, np.pad(t, 1))  # one empty sample around: a closed solid
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--chunks", default="64,128")
+    ap.add_argument("--halos", default="8,16,24,32")
+    ap.add_argument("--threads", default="2")
+    args = ap.parse_args()
+    chunks = [int(c) for c in args.chunks.split(",")]
+    halos = [int(h) for h in args.halos.split(",")]
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="voxpress_seams_"))
+    inputs = []
+    for shape in ["sphere", "cad-part"]:
+        p = tmp / f"{shape}.nrrd"
+        run(["-q", "generate", shape, "--res", "256", "--rotate", "random:1", "-o", str(p)])
+        inputs.append((f"{shape} 256³ (rotated)", p))
+    if heart.exists():
+        p = tmp / "heart512.nrrd"
+        tiled_heart(p, 512)
+        inputs.append(("totalseg_heart tiled to 512³", p))
+    else:
+        print(f"skipping the tiled heart: {heart} is absent", file=sys.stderr)
+    print("| input | run | time | peak RSS | topology | max diff | RMS diff | check |")
+    print("|---|---|---:|---:|---|---:|---:|---|")
+    for name, p in inputs:
+        whole = tmp / "whole.ply"
+        _, s, rss = run(["-q", "--threads", args.threads, "press", str(p), "--no-flats", "-o", str(whole)])
+        wv, wf = read_ply(whole)
+        print(f"| {name} | whole, `--no-flats` | {s:.1f} s | {rss:.0f} MB | {len(wf)} faces | | | |", flush=True)
+        for c in chunks:
+            for h in halos:
+                out = tmp / "chunk.ply"
+                # --check throws (non-zero exit, run() stops) unless every check passes.
+                _, s, rss = run(["--threads", args.threads, "press", str(p), "--chunk", str(c), "--halo", str(h),
+                                    "--check", "-o", str(out)])
+                cv, cf = read_ply(out)
+                same = wf.shape == cf.shape and bool((wf == cf).all())
+                d = np.linalg.norm(wv - cv, axis=1) if same else np.array([np.nan])
+                print(f"| {name} | `--chunk {c} --halo {h}` | {s:.1f} s | {rss:.0f} MB | "
+                      f"{'same' if same else 'DIFFERENT'} | {d.max():.2g} | {np.sqrt((d ** 2).mean()):.2g} | passes |",
+                      flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,166 @@
+// The chunked core for Python: chunk_plan (the blocks and the boxes to read),
+// _press_block (one block's piece: numpy arrays of global stick keys, so a
+// piece pickles compactly for Dask), _stitch (pieces -> Mesh), and the
+// in-process press(..., chunk=) path. voxpress/dask.py maps _press_block
+// over a Dask array's blocks; the results are the CLI's `press --chunk`.
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+#include "py_common.h"
+
+namespace voxpress::python {
+namespace {
+
+using Corner = std::array<int64_t, 3>;
+
+Corner corner(const py::handle& o, const char* what) {
+  const auto v = o.cast<std::vector<int64_t>>();
+  if (v.size() != 3) throw UsageError(std::string(what) + " must have 3 values");
+  return {v[0], v[1], v[2]};
+}
+
+template <class T>
+py::array_t<T> to_numpy(const std::vector<T>& v) {
+  py::array_t<T> a(py::ssize_t(v.size()));
+  if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
+  return a;
+}
+
+template <class T>
+std::vector<T> from_numpy(const py::dict& piece, const char* key) {
+  if (!piece.contains(key)) throw UsageError(std::string("a piece lacks '") + key + "' (not from _press_block?)");
+  const auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(piece[key]);
+  if (!a) throw UsageError(std::string("a piece's '") + key + "' is not an array");
+  return std::vector<T>(a.data(), a.data() + a.size());
+}
+
+// The whole volume's lattice from shape, spacing, origin, direction.
+Lattice whole_lattice(const py::handle& shape, const py::object& spacing, const py::object& origin,
+                      const py::object& direction) {
+  const Corner dims = corner(shape, "shape");
+  py::array_t<uint8_t> one(std::vector<py::ssize_t>{1, 1, 1});
+  ScalarVolume v = to_volume(one, spacing, origin, direction, "xyz");  // validates spacing, origin, direction
+  v.lattice.dims = dims;
+  v.lattice.validate();
+  return v.lattice;
+}
+
+py::list py_chunk_plan(const py::handle& shape, int64_t chunk, int64_t halo) {
+  const ChunkGrid grid(corner(shape, "shape"), ChunkOptions{chunk, halo});
+  py::list out;
+  for (size_t b = 0; b < grid.count(); ++b) {
+    const Box core = grid.core(b), read = grid.with_halo(b);
+    py::dict d;
+    d["block"] = b;
+    d["core"] = py::make_tuple(py::cast(core.lo), py::cast(core.hi));
+    d["read"] = py::make_tuple(py::cast(read.lo), py::cast(read.hi));
+    out.append(d);
+  }
+  return out;
+}
+
+py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
+                        const py::tuple& bounds, const py::object& spacing, const py::object& origin,
+                        const py::object& direction, const py::kwargs& kw) {
+  SurfaceOptions o;
+  set_options(o, kw);
+  const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
+  const ChunkGrid grid(lattice.dims, ChunkOptions{chunk, halo});
+  if (block >= grid.count()) throw UsageError("block " + std::to_string(block) + " is not in the plan");
+  if (bounds.size() != 2) throw UsageError("bounds must be (lo, hi): the box of the inside samples");
+  VolumeSummary summary;
+  summary.bounds = {corner(bounds[0], "bounds lo"), corner(bounds[1], "bounds hi")};
+  const Box box = grid.with_halo(block);
+  ScalarVolume scalar = to_volume(mask, py::make_tuple(1, 1, 1), py::make_tuple(0, 0, 0), py::none(), "xyz");
+  if (scalar.lattice.dims != box.dims())
+    throw UsageError("block " + std::to_string(block) + " must be the array's box read = (lo, hi) of chunk_plan");
+  SurfacePiece piece;
+  {
+    py::gil_scoped_release release;
+    Selection nonzero;
+    nonzero.kind = Selection::Kind::nonzero;
+    BinaryVolume b = select_samples(scalar, nonzero);
+    b.lattice = box_lattice(lattice, box);
+    b.source = "array";
+    piece = press_block(b, grid, block, chunk_surface_options(o, summary));
+  }
+  py::dict d;
+  d["block"] = piece.block;
+  d["blocks"] = piece.blocks;
+  d["sticks"] = to_numpy(piece.sticks);
+  d["code"] = to_numpy(piece.code);
+  d["t"] = to_numpy(piece.t);
+  d["triangles"] = to_numpy(piece.triangles);
+  d["iterations"] = piece.press.iterations;
+  return d;
+}
+
+PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::object& spacing, const py::object& origin,
+                 const py::object& direction) {
+  const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
+  std::vector<SurfacePiece> ps;
+  for (const py::handle& h : pieces) {
+    const py::dict d = h.cast<py::dict>();
+    SurfacePiece p;
+    p.block = d["block"].cast<uint64_t>();
+    p.blocks = d["blocks"].cast<uint64_t>();
+    p.sticks = from_numpy<uint64_t>(d, "sticks");
+    p.code = from_numpy<uint8_t>(d, "code");
+    p.t = from_numpy<double>(d, "t");
+    p.triangles = from_numpy<uint64_t>(d, "triangles");
+    if (p.code.size() != p.sticks.size() || p.t.size() != p.sticks.size() || p.triangles.size() % 3)
+      throw UsageError("a piece's arrays do not match (sticks, code, t, triangles)");
+    ps.push_back(std::move(p));
+  }
+  PyMesh out;
+  {
+    py::gil_scoped_release release;
+    const StickSurface s = stitch(lattice, ps);
+    ps = {};
+    out.mesh = to_mesh(s);
+  }
+  out.stats["method"] = "pressing";
+  out.stats["blocks"] = py::len(pieces);
+  out.stats["vertices"] = out.mesh.vertex_count();
+  out.stats["triangles"] = out.mesh.face_count();
+  return out;
+}
+
+}  // namespace
+
+PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, const SurfaceOptions& o,
+                            const ChunkOptions& chunks) {
+  PyMesh out;
+  ChunkedStats st;
+  {
+    py::gil_scoped_release release;
+    const BinaryVolume volume = binarize(scalar, sel);
+    out.mesh = press_chunked(volume.lattice, "array", [&](const Box& box) { return crop(volume, box); }, o, chunks, &st);
+  }
+  out.stats["method"] = "pressing";
+  out.stats["blocks"] = st.blocks;
+  out.stats["sticks"] = st.sticks;
+  out.stats["vertices"] = out.mesh.vertex_count();
+  out.stats["triangles"] = out.mesh.face_count();
+  out.stats["iterations"] = st.max_iterations;
+  out.stats["flats"] = 0;
+  out.stats["keeps_classification"] = true;
+  out.stats["seconds_blocks"] = st.seconds_blocks;
+  out.stats["seconds_stitch"] = st.seconds_stitch;
+  return out;
+}
+
+void bind_chunks(py::module_& m) {
+  m.def("chunk_plan", &py_chunk_plan, py::arg("shape"), py::kw_only(), py::arg("chunk") = 256, py::arg("halo") = 24,
+        "The blocks of a volume: [{block, core: (lo, hi), read: (lo, hi)}], x fastest.");
+  m.def("_press_block", &py_press_block, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
+        py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
+        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(),
+        "One block's piece (voxpress.dask): mask is the block's read box, non-zero inside.");
+  m.def("_stitch", &py_stitch, py::arg("pieces"), py::kw_only(), py::arg("shape"),
+        py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
+        py::arg("direction") = py::none(), "The mesh of every block's piece (any order).");
+}
+
+}  // namespace voxpress::python

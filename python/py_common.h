@@ -1,0 +1,36 @@
+// What the module's binding files share (private to python/).
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <string>
+
+#include "voxpress/voxpress.h"
+
+namespace py = pybind11;
+
+namespace voxpress::python {
+
+/// A mesh and the statistics of the call that made it.
+struct PyMesh {
+  Mesh mesh;
+  py::dict stats;
+};
+
+/// The array as a ScalarVolume on its lattice, x fastest whatever its memory
+/// order; axes "xyz": a[i, j, k], "zyx": a[k, j, i].
+ScalarVolume to_volume(const py::array& a, const py::object& spacing, const py::object& origin,
+                       const py::object& direction, const std::string& axes);
+/// label= / threshold= as a Selection (automatic when both are None).
+Selection selection(const py::object& label, const py::object& threshold);
+/// press()'s keyword options (iterations, tolerance, flats, ...).
+void set_options(SurfaceOptions& o, const py::kwargs& kw);
+
+/// chunk_plan, _press_block, _stitch (chunk_py.cpp).
+void bind_chunks(py::module_& m);
+/// press(..., chunk=N): press_chunked on the in-memory volume.
+PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, const SurfaceOptions& o,
+                            const ChunkOptions& chunks);
+
+}  // namespace voxpress::python

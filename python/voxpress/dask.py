@@ -1,0 +1,92 @@
+"""Chunked Pressing on Dask: volumes larger than one machine.
+
+    import dask.array as da, voxpress.dask
+    from dask.distributed import Client
+    client = Client("scheduler:8786")                  # or LocalCluster(), dask-jobqueue, Kubernetes
+    mask = da.from_zarr("cells.zarr", component="mask")
+    mesh = voxpress.dask.press(mask, chunk=256, spacing=(0.5, 0.5, 2.0))
+    mesh.save("cells.ply")
+
+The volume is cut into blocks of `chunk` samples per side (voxpress.chunk_plan).
+Each block, read with `halo` more samples on every side, is one Dask task
+(voxpress._press_block, run on a worker) returning its piece of the surface:
+numpy arrays of global stick keys, codes, pressed positions and triangles,
+which pickle compactly. The pieces are stitched by key on the caller into
+one mesh with exactly the sticks, triangles and order of the whole-volume
+run; the result is byte for byte `voxpress press --chunk` on the same
+samples. Flats are off, as with --chunk. Dask does the scheduling, transfer
+and retries; nothing here is a scheduler.
+"""
+import numpy as np
+
+from . import _voxpress
+
+
+def _inside(array, label, threshold):
+    """The inside samples as a boolean Dask array (lazy)."""
+    if label is not None and threshold is not None:
+        raise _voxpress.UsageError("choose one of label and threshold")
+    if threshold is not None:
+        return array >= threshold
+    if label is not None and label not in ("all-nonzero", "nonzero"):
+        return array == label
+    if array.dtype == bool:
+        return array
+    return array != 0
+
+
+def _block(mask, **kw):
+    return _voxpress._press_block(np.asarray(mask), **kw)
+
+
+def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
+          label=None, threshold=None, client=None, iterations=None, tolerance=None, fit_rings=None):
+    """The smooth surface of a Dask, Zarr or numpy array, block by block on Dask; returns a Mesh.
+
+    array: indexed array[i, j, k] (x first); a zarr array is wrapped with
+    dask.array.from_zarr. Inside: non-zero samples (a bool mask as is);
+    label=N takes array == N, threshold=T array >= T. spacing, origin and
+    direction are press()'s. chunk and halo are `press --chunk N --halo H`
+    (docs/BENCHMARKS.md, Chunked: halo 24 keeps vertices within ~0.01 cell
+    of the whole-volume run). client: a dask.distributed Client; None uses
+    Dask's current scheduler (a Client you created, else threads).
+    """
+    import dask
+    import dask.array as da
+
+    if not isinstance(array, da.Array):
+        if type(array).__module__.startswith("zarr"):
+            array = da.from_zarr(array)
+        else:
+            array = da.from_array(np.asarray(array), chunks=chunk)
+    if array.ndim != 3:
+        raise _voxpress.UsageError(f"the array must be 3-D (got {array.ndim} dimensions)")
+    shape = tuple(int(n) for n in array.shape)
+    inside = _inside(array, label, threshold)
+    # Inside count and box: three 1-D projections, one pass over the blocks.
+    counts = [inside.sum(axis=tuple(a for a in range(3) if a != axis)) for axis in range(3)]
+    counts = client.gather(client.compute(counts)) if client is not None else dask.compute(*counts)
+    total = int(counts[0].sum())
+    if total == 0:
+        raise _voxpress.InputError("array: the volume is empty: no sample is inside (check label / threshold)")
+    if total == int(np.prod(shape)):
+        raise _voxpress.InputError("array: the volume is full: every sample is inside, so the only surface is the "
+                                   "grid's bounding box (check label / threshold)")
+    lo = [int(np.flatnonzero(c)[0]) for c in counts]
+    hi = [int(np.flatnonzero(c)[-1]) + 1 for c in counts]
+    options = {k: v for k, v in dict(iterations=iterations, tolerance=tolerance, fit_rings=fit_rings).items()
+               if v is not None}
+    plan = _voxpress.chunk_plan(shape, chunk=chunk, halo=halo)
+    block = dask.delayed(_block, pure=True)
+    tasks = []
+    for b in plan:
+        (x0, y0, z0), (x1, y1, z1) = b["read"]
+        tasks.append(block(inside[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, halo=halo,
+                           bounds=(lo, hi), spacing=spacing, origin=origin, direction=direction, **options))
+    if client is not None:
+        pieces = client.gather(client.compute(tasks))
+    else:
+        pieces = dask.compute(*tasks)
+    mesh = _voxpress._stitch(list(pieces), shape=shape, spacing=spacing, origin=origin, direction=direction)
+    mesh.stats["max_iterations"] = max(p["iterations"] for p in pieces)
+    return mesh

@@ -1,0 +1,80 @@
+// press --chunk from the command line: a raw NRRD streamed block by block
+// and the same samples gzip-compressed (read whole) write the same bytes,
+// pass --check, resolve an automatic selection over the whole file, and bad
+// options leave no output file.
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "test_util.h"
+
+namespace voxpress {
+namespace {
+
+using test::run_cli;
+
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(std::ifstream(path)); }
+
+TEST(ChunkCli, StreamedAndWholeFilesWriteTheSameCheckedBytes) {
+  test::TempDir tmp;
+  std::string out;
+  ASSERT_EQ(run_cli("-q generate cad-part --res 48 --rotate random:2 --spacing 1,1,1.5 -o " + tmp.path("gz.nrrd"), &out), 0)
+      << out;
+  WriteVolumeOptions raw;
+  raw.compress = false;
+  write_volume(tmp.path("raw.nrrd"), read_volume(tmp.path("gz.nrrd")), raw);
+  for (const char* name : {"raw", "gz"}) {
+    const std::string in = tmp.path(std::string(name) + ".nrrd");
+    ASSERT_EQ(run_cli("-q press " + in + " --chunk 16 --halo 6 --check --stats-json " + tmp.path(std::string(name) + ".json") +
+                          " -o " + tmp.path(std::string(name) + ".ply"),
+                      &out),
+              0)
+        << out;
+    EXPECT_EQ(read_json(tmp.path(std::string(name) + ".json"))["chunks"]["streamed"].get<bool>(), std::string(name) == "raw");
+    EXPECT_EQ(read_json(tmp.path(std::string(name) + ".json"))["checks"]["classification_violations"].get<uint64_t>(), 0u);
+  }
+  const std::string a = test::read_file(tmp.path("raw.ply")), b = test::read_file(tmp.path("gz.ply"));
+  EXPECT_FALSE(a.empty());
+  EXPECT_TRUE(a == b) << "the streamed and the whole file's meshes differ";
+  // 1 and 2 threads: the same bytes.
+  ASSERT_EQ(run_cli("-q --threads 1 press " + tmp.path("raw.nrrd") + " --chunk 16 --halo 6 -o " + tmp.path("one.ply")), 0);
+  EXPECT_TRUE(test::read_file(tmp.path("one.ply")) == a);
+}
+
+TEST(ChunkCli, SelectionsResolveOverTheWholeFileAndBadOptionsWriteNothing) {
+  test::TempDir tmp;
+  // Two labels far apart: most blocks see one value or none.
+  ScalarVolume v;
+  v.lattice.dims = {40, 20, 20};
+  v.bytes.assign(v.lattice.size(), std::byte{0});
+  for (int64_t k = 4; k < 16; ++k)
+    for (int64_t j = 4; j < 16; ++j) {
+      for (int64_t i = 3; i < 12; ++i) v.bytes[v.lattice.linear(i, j, k)] = std::byte{1};
+      for (int64_t i = 28; i < 37; ++i) v.bytes[v.lattice.linear(i, j, k)] = std::byte{2};
+    }
+  WriteVolumeOptions raw;
+  raw.compress = false;
+  write_volume(tmp.path("labels.nrrd"), v, raw);
+  const std::string in = tmp.path("labels.nrrd"), o = " -o " + tmp.path("x.ply");
+  std::string out;
+  EXPECT_EQ(run_cli("-q press " + in + " --chunk 10 --halo 4" + o, &out), 1);
+  EXPECT_NE(out.find("label map with 2 labels"), std::string::npos) << out;
+  EXPECT_NE(out.find("labels.nrrd"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q press " + in + " --chunk 10 --halo 4 --label 7" + o, &out), 1);
+  EXPECT_NE(out.find("empty"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q press " + in + " --halo 4" + o, &out), 2);
+  EXPECT_EQ(run_cli("-q press " + in + " --chunk 4" + o, &out), 2);
+  EXPECT_EQ(run_cli("-q press " + in + " --chunk 10 --no-sharpen" + o, &out), 2);
+  EXPECT_EQ(run_cli("-q press " + tmp.path("absent.nrrd") + " --chunk 10" + o, &out), 1);
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
+  // --label 2 streamed equals --label 2 on a mask of label 2 alone.
+  ASSERT_EQ(run_cli("-q press " + in + " --chunk 10 --halo 4 --label 2 --check -o " + tmp.path("two.ply"), &out), 0) << out;
+  for (auto& b : v.bytes) b = b == std::byte{2} ? std::byte{1} : std::byte{0};
+  write_volume(tmp.path("two.nrrd"), v, raw);
+  ASSERT_EQ(run_cli("-q press " + tmp.path("two.nrrd") + " --chunk 10 --halo 4 -o " + tmp.path("mask.ply"), &out), 0) << out;
+  EXPECT_TRUE(test::read_file(tmp.path("two.ply")) == test::read_file(tmp.path("mask.ply")));
+}
+
+}  // namespace
+}  // namespace voxpress

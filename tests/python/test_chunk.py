@@ -1,0 +1,82 @@
+"""Chunked Pressing from Python: press(..., chunk=) is `press --chunk`, and
+voxpress.dask.press on a LocalCluster of 2 worker processes gives the same
+bytes as the in-process chunked run.
+"""
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import voxpress
+
+CLI = os.environ.get("VOXPRESS_CLI", "voxpress")
+
+
+def cli(*args):
+    subprocess.run([CLI, "-q", *map(str, args)], check=True, capture_output=True)
+
+
+def test_chunked_press_is_the_clis(tmp_path):
+    vol = tmp_path / "part.nrrd"
+    cli("generate", "cad-part", "--res", 40, "--rotate", "random:4", "--spacing", "1,0.9,1.3", "-o", vol)
+    cli("press", vol, "--chunk", 16, "--halo", 5, "-o", tmp_path / "cli.ply")
+    data, lattice = voxpress.read_volume(str(vol))
+    mesh = voxpress.press(data, spacing=lattice.spacing, origin=lattice.origin, direction=lattice.direction,
+                          chunk=16, halo=5)
+    ref = voxpress.read_mesh(str(tmp_path / "cli.ply"))
+    np.testing.assert_array_equal(mesh.faces, ref.faces)
+    np.testing.assert_array_equal(mesh.vertices, ref.vertices)
+    assert mesh.stats["blocks"] == len(voxpress.chunk_plan(data.shape, chunk=16, halo=5))
+    assert voxpress.check(mesh, data, spacing=lattice.spacing, origin=lattice.origin,
+                          direction=lattice.direction)["ok"]
+    with pytest.raises(voxpress.UsageError):
+        voxpress.press(data, halo=5)
+    with pytest.raises(voxpress.UsageError):
+        voxpress.press(data, chunk=4)
+
+
+def test_plan_covers_the_volume_once():
+    plan = voxpress.chunk_plan((50, 33, 17), chunk=16, halo=3)
+    seen = np.zeros((50, 33, 17), dtype=int)
+    for b in plan:
+        (x0, y0, z0), (x1, y1, z1) = b["core"]
+        seen[x0:x1, y0:y1, z0:z1] += 1
+        (rx0, ry0, rz0), (rx1, ry1, rz1) = b["read"]
+        assert rx0 == max(0, x0 - 3) and rx1 == min(50, x1 + 3) and rz1 == min(17, z1 + 3)
+    assert (seen == 1).all()
+    assert [b["block"] for b in plan] == list(range(len(plan)))
+
+
+def sphere(n, seed=1):
+    rng = np.random.default_rng(seed)
+    c = n / 2 + rng.uniform(-0.5, 0.5, 3)
+    i, j, k = np.indices((n, n, n), dtype=np.float32)
+    return (i - c[0]) ** 2 + ((j - c[1]) / 0.9) ** 2 + ((k - c[2]) / 1.1) ** 2 < (0.38 * n) ** 2
+
+
+def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
+    dask = pytest.importorskip("dask")
+    distributed = pytest.importorskip("distributed")
+    import dask.array as da
+
+    import voxpress.dask
+
+    mask = sphere(256)
+    spacing, origin = (0.8, 0.8, 1.2), (-3.0, 4.0, 10.0)
+    ref = voxpress.press(mask, spacing=spacing, origin=origin, chunk=128, halo=24)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        array = da.from_array(mask.astype(np.uint8), chunks=96)  # Dask's chunks need not be the blocks
+        mesh = voxpress.dask.press(array, chunk=128, halo=24, spacing=spacing, origin=origin, client=client)
+    np.testing.assert_array_equal(mesh.faces, ref.faces)
+    np.testing.assert_array_equal(mesh.vertices, ref.vertices)
+    assert mesh.stats["blocks"] == 8
+    assert voxpress.check(mesh)["ok"]
+    # The threaded scheduler (no client) and a label selection: the same again.
+    labels = np.where(mask, 3, 0).astype(np.int16)
+    again = voxpress.dask.press(da.from_array(labels[100:164, 100:164, 20:84], chunks=32), chunk=32, halo=8, label=3)
+    small = voxpress.press(mask[100:164, 100:164, 20:84], chunk=32, halo=8)
+    np.testing.assert_array_equal(again.vertices, small.vertices)
+    with pytest.raises(voxpress.InputError):
+        voxpress.dask.press(da.zeros((32, 32, 32), chunks=16), chunk=16)
