@@ -4,6 +4,7 @@
 // in-process press(..., chunk=) path. voxpress/dask.py maps _press_block
 // over a Dask array's blocks; the results are the CLI's `press --chunk`.
 #include <pybind11/stl.h>
+#include <tbb/task_arena.h>
 
 #include <cstring>
 
@@ -62,7 +63,7 @@ py::list py_chunk_plan(const py::handle& shape, int64_t chunk, int64_t halo) {
 
 py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
                         const py::tuple& bounds, const py::object& spacing, const py::object& origin,
-                        const py::object& direction, const py::kwargs& kw) {
+                        const py::object& direction, int threads, const py::kwargs& kw) {
   SurfaceOptions o;
   set_options(o, kw);
   const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
@@ -83,7 +84,13 @@ py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t b
     BinaryVolume b = select_samples(scalar, nonzero);
     b.lattice = box_lattice(lattice, box);
     b.source = "array";
-    piece = press_block(b, grid, block, chunk_surface_options(o, summary));
+    const SurfaceOptions so = chunk_surface_options(o, summary);
+    if (threads > 0) {  // a Dask worker's share of the machine
+      tbb::task_arena arena(threads);
+      arena.execute([&] { piece = press_block(b, grid, block, so); });
+    } else {
+      piece = press_block(b, grid, block, so);
+    }
   }
   py::dict d;
   d["block"] = piece.block;
@@ -156,8 +163,8 @@ void bind_chunks(py::module_& m) {
         "The blocks of a volume: [{block, core: (lo, hi), read: (lo, hi)}], x fastest.");
   m.def("_press_block", &py_press_block, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
         py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
-        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(),
-        "One block's piece (voxpress.dask): mask is the block's read box, non-zero inside.");
+        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
+        "One block's piece (voxpress.dask): mask is the block's read box, non-zero inside; threads 0: all cores.");
   m.def("_stitch", &py_stitch, py::arg("pieces"), py::kw_only(), py::arg("shape"),
         py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
         py::arg("direction") = py::none(), "The mesh of every block's piece (any order).");

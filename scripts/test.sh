@@ -2,7 +2,7 @@
 # scripts/test.sh — sets everything up (apt packages, Node test tools,
 # Chromium), builds in Release and runs the whole test suite, then builds the
 # library and its unit and property tests again with AddressSanitizer and
-# UndefinedBehaviorSanitizer (-O1, build-asan/) and runs them. CI runs
+# UndefinedBehaviorSanitizer (clang, -O1, build-asan/) and runs them. CI runs
 # exactly this. VOXPRESS_NO_SANITIZE=1 skips the second part (local use).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -34,8 +34,9 @@ phase "sanitized build done"
 # the conversion of the shared voxel art (its parsing is checked by
 # Voxart.SharedFilesHaveTheDocumentedContents); the crossing plates and the
 # generated shapes at random rotations (the property corpus holds both
-# kinds, smaller). The corpus itself is smaller under the sanitizers
-# (tests/test_util.cpp).
+# kinds, smaller); the metric, truth and option-effect checks on 64-128^3
+# volumes (their code runs in the suites kept, on smaller inputs). The
+# corpus itself is smaller under the sanitizers (tests/test_util.cpp).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndItsCreasesAreFound:Sharpen.RotatedBoxesGetTheirEdgesBack:\
 Sharpen.SharpAngleOptionControlsTheLabels:Sharpen.ThinPlatesGetBothEdgesOfTheirRim:\
@@ -51,7 +52,13 @@ Written.AnisotropicPartFarFromTheOriginKeepsTheGuaranteeInEveryFormat:Passes.Eac
 Flats.FandiskPlanarFacesFoundAndStagesBeatTheMidpoint:Flats.PropertyCorpusKeepsEveryGuarantee:\
 Pipeline.SameMeshForOneAndManyThreadsOnThePropertyVolumes:Sharpen.SameResultForOneAndManyThreads:\
 Flats.SameResultForOneAndManyThreads:Voxart.SharedVoxelArtLoadsAndConverts:\
-Sharpen.CrossingThinPlatesKeepEveryGuarantee:Pressing.GeneratedShapesAtRandomRotationsStayValid"
+Sharpen.CrossingThinPlatesKeepEveryGuarantee:Pressing.GeneratedShapesAtRandomRotationsStayValid:\
+Metrics.ScaledSphereHasTheAnalyticDistanceAndVolume:Metrics.QuadratureRmsAgreesWithTheSamplesAndIgnoresTheirSeed:\
+Metrics.MidpointRowOnFandisk:Metrics.RotatedBoxMatchesQuadrature:Metrics.TranslatedBoxMatchesQuadrature:\
+Truth.SharpEdges:Shapes.SampledVolumeMatchesAnalyticVolume:Flats.JunctionAngleOptionControlsJunctions:\
+Sharpen.CurvedCreasesOnlyWhereTheyContinueAFlatsCrease:Pressing.ArcLengthResamplingBeatsThePlainBilaplacian:\
+Pipeline.PressingStagesAndOverridesAreHonoured:Flats.WithoutFlatsTheResultIsThePlainPress:\
+Pressing.AnisotropicSpacingWorksInPhysicalSpace"
 # smooth_tests, the longest, runs as three shards.
 runs=(smooth_tests:0:3 smooth_tests:1:3 smooth_tests:2:3)
 for s in "${suites[@]}"; do if [ "$s" != smooth_tests ]; then runs+=("$s:0:1"); fi; done

@@ -40,7 +40,7 @@ def _block(mask, **kw):
 
 
 def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
-          label=None, threshold=None, client=None, iterations=None, tolerance=None, fit_rings=None):
+          label=None, threshold=None, client=None, threads=0, iterations=None, tolerance=None, fit_rings=None):
     """The smooth surface of a Dask, Zarr or numpy array, block by block on Dask; returns a Mesh.
 
     array: indexed array[i, j, k] (x first); a zarr array is wrapped with
@@ -49,7 +49,10 @@ def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
     direction are press()'s. chunk and halo are `press --chunk N --halo H`
     (docs/BENCHMARKS.md, Chunked: halo 24 keeps vertices within ~0.01 cell
     of the whole-volume run). client: a dask.distributed Client; None uses
-    Dask's current scheduler (a Client you created, else threads).
+    Dask's current scheduler (a Client you created, else threads). threads:
+    cores one block task uses (0: all the worker's machine has; set it to
+    the worker's threads when several workers share a machine). The result
+    does not depend on it.
     """
     import dask
     import dask.array as da
@@ -82,7 +85,8 @@ def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
     for b in plan:
         (x0, y0, z0), (x1, y1, z1) = b["read"]
         tasks.append(block(inside[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, halo=halo,
-                           bounds=(lo, hi), spacing=spacing, origin=origin, direction=direction, **options))
+                           bounds=(lo, hi), spacing=spacing, origin=origin, direction=direction, threads=threads,
+                           **options))
     if client is not None:
         pieces = client.gather(client.compute(tasks))
     else:
