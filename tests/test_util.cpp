@@ -204,6 +204,32 @@ void expect_guarantees(const Mesh& m, const BinaryVolume& v) {
   }
 }
 
+ScalarVolume random_scalar_volume(ScalarType type, std::array<int64_t, 3> dims, uint64_t seed, int64_t components,
+                                  int64_t max_value) {
+  ScalarVolume v;
+  v.type = type;
+  v.components = components;
+  v.lattice.dims = dims;
+  v.lattice.spacing = Vec3(0.7, 1.25, 2.5);
+  v.lattice.origin = Vec3(-12.5, 3.25, 100);
+  v.lattice.direction = Eigen::AngleAxisd(0.3, Vec3(1, 2, 2).normalized()).toRotationMatrix();
+  v.lattice.space = Space::LPS;
+  v.bytes.resize(v.value_count() * scalar_size(type));
+  Rng rng(seed);
+  v.visit([&](auto values) {
+    using T = typename decltype(values)::value_type;
+    T* p = const_cast<T*>(values.data());
+    for (size_t i = 0; i < values.size(); ++i) p[i] = T(rng.range(0, max_value));
+  });
+  return v;
+}
+
+void write_raw_volume(const std::string& path, const ScalarVolume& v) {
+  WriteVolumeOptions raw;
+  raw.compress = false;
+  write_volume(path, v, raw);
+}
+
 std::vector<Case> property_volumes() {
   std::vector<Case> out;
   Rng rng(2024);

@@ -71,6 +71,12 @@ class Rng {
 
 BinaryVolume make_volume(int64_t nx, int64_t ny, int64_t nz);
 BinaryVolume random_noise(Rng& rng, std::array<int64_t, 3> dims, double density);
+/// A scalar volume of random values in [0, max_value] (as `type`), on a
+/// rotated, anisotropic LPS lattice away from the origin.
+ScalarVolume random_scalar_volume(ScalarType type, std::array<int64_t, 3> dims, uint64_t seed, int64_t components = 1,
+                                  int64_t max_value = 100);
+/// Writes a volume uncompressed (a raw NRRD streams block by block).
+void write_raw_volume(const std::string& path, const ScalarVolume& v);
 BinaryVolume random_blobs(Rng& rng, std::array<int64_t, 3> dims, int blobs);
 /// Inside where (i + j + k) % 2 == 0 (every neighbour pair differs).
 BinaryVolume checkerboard(std::array<int64_t, 3> dims, int period_axes = 7);

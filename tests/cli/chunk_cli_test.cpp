@@ -21,9 +21,7 @@ TEST(ChunkCli, StreamedAndWholeFilesWriteTheSameCheckedBytes) {
   std::string out;
   ASSERT_EQ(run_cli("-q generate cad-part --res 48 --rotate random:2 --spacing 1,1,1.5 -o " + tmp.path("gz.nrrd"), &out), 0)
       << out;
-  WriteVolumeOptions raw;
-  raw.compress = false;
-  write_volume(tmp.path("raw.nrrd"), read_volume(tmp.path("gz.nrrd")), raw);
+  test::write_raw_volume(tmp.path("raw.nrrd"), read_volume(tmp.path("gz.nrrd")));
   for (const char* name : {"raw", "gz"}) {
     const std::string in = tmp.path(std::string(name) + ".nrrd");
     ASSERT_EQ(run_cli("-q press " + in + " --chunk 16 --halo 6 --check --stats-json " + tmp.path(std::string(name) + ".json") +
@@ -53,9 +51,7 @@ TEST(ChunkCli, SelectionsResolveOverTheWholeFileAndBadOptionsWriteNothing) {
       for (int64_t i = 3; i < 12; ++i) v.bytes[v.lattice.linear(i, j, k)] = std::byte{1};
       for (int64_t i = 28; i < 37; ++i) v.bytes[v.lattice.linear(i, j, k)] = std::byte{2};
     }
-  WriteVolumeOptions raw;
-  raw.compress = false;
-  write_volume(tmp.path("labels.nrrd"), v, raw);
+  test::write_raw_volume(tmp.path("labels.nrrd"), v);
   const std::string in = tmp.path("labels.nrrd"), o = " -o " + tmp.path("x.ply");
   std::string out;
   EXPECT_EQ(run_cli("-q press " + in + " --chunk 10 --halo 4" + o, &out), 1);
@@ -71,7 +67,7 @@ TEST(ChunkCli, SelectionsResolveOverTheWholeFileAndBadOptionsWriteNothing) {
   // --label 2 streamed equals --label 2 on a mask of label 2 alone.
   ASSERT_EQ(run_cli("-q press " + in + " --chunk 10 --halo 4 --label 2 --check -o " + tmp.path("two.ply"), &out), 0) << out;
   for (auto& b : v.bytes) b = b == std::byte{2} ? std::byte{1} : std::byte{0};
-  write_volume(tmp.path("two.nrrd"), v, raw);
+  test::write_raw_volume(tmp.path("two.nrrd"), v);
   ASSERT_EQ(run_cli("-q press " + tmp.path("two.nrrd") + " --chunk 10 --halo 4 -o " + tmp.path("mask.ply"), &out), 0) << out;
   EXPECT_TRUE(test::read_file(tmp.path("two.ply")) == test::read_file(tmp.path("mask.ply")));
 }

@@ -27,21 +27,7 @@ std::string gzip(const std::string& s) {
 }
 
 ScalarVolume random_volume(ScalarType type, std::array<int64_t, 3> dims, uint64_t seed) {
-  ScalarVolume v;
-  v.type = type;
-  v.lattice.dims = dims;
-  v.lattice.spacing = Vec3(0.7, 1.25, 2.5);
-  v.lattice.origin = Vec3(-12.5, 3.25, 100);
-  v.lattice.direction = Eigen::AngleAxisd(0.3, Vec3(1, 2, 2).normalized()).toRotationMatrix();
-  v.lattice.space = Space::LPS;
-  v.bytes.resize(v.value_count() * scalar_size(type));
-  test::Rng rng(seed);
-  v.visit([&](auto values) {
-    using T = typename decltype(values)::value_type;
-    T* p = const_cast<T*>(values.data());
-    for (size_t i = 0; i < values.size(); ++i) p[i] = T(rng.range(0, 100));
-  });
-  return v;
+  return test::random_scalar_volume(type, dims, seed);
 }
 
 void expect_same_lattice(const Lattice& a, const Lattice& b, double tol = 1e-9) {
