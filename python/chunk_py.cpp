@@ -85,11 +85,12 @@ py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t b
     b.lattice = box_lattice(lattice, box);
     b.source = "array";
     const SurfaceOptions so = chunk_surface_options(o, summary);
+    const SurfaceOptions* pressed = halo > 0 ? &so : nullptr;  // halo 0: extraction only (exact mode)
     if (threads > 0) {  // a Dask worker's share of the machine
       tbb::task_arena arena(threads);
-      arena.execute([&] { piece = press_block(b, grid, block, so); });
+      arena.execute([&] { piece = press_block(b, grid, block, pressed); });
     } else {
-      piece = press_block(b, grid, block, so);
+      piece = press_block(b, grid, block, pressed);
     }
   }
   py::dict d;
@@ -104,7 +105,9 @@ py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t b
 }
 
 PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::object& spacing, const py::object& origin,
-                 const py::object& direction) {
+                 const py::object& direction, bool smooth, const py::kwargs& kw) {
+  SurfaceOptions o;
+  set_options(o, kw);
   const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
   std::vector<SurfacePiece> ps;
   for (const py::handle& h : pieces) {
@@ -121,11 +124,25 @@ PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::obje
     ps.push_back(std::move(p));
   }
   PyMesh out;
+  int iterations = 0;
+  size_t flats = 0;
   {
-    py::gil_scoped_release release;
-    const StickSurface s = stitch(lattice, ps);
+    py::gil_scoped_release release;  // no Python object is touched in here
+    StickSurface s = stitch(lattice, ps);
     ps = {};
-    out.mesh = to_mesh(s);
+    if (smooth) {  // the exact mode: the pieces' sticks are the whole volume's, smoothed here at once
+      require_float32_room(lattice, o, "array");
+      SurfaceResult r = smooth_sticks(std::move(s), o);
+      out.mesh = std::move(r.mesh);
+      iterations = r.press.iterations;
+      flats = r.flats.flats.size();
+    } else {
+      out.mesh = to_mesh(s);
+    }
+  }
+  if (smooth) {
+    out.stats["iterations"] = iterations;
+    out.stats["flats"] = flats;
   }
   out.stats["method"] = "pressing";
   out.stats["blocks"] = py::len(pieces);
@@ -140,26 +157,29 @@ PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, co
                             const ChunkOptions& chunks) {
   PyMesh out;
   ChunkedStats st;
+  SurfaceResult r;
   {
     py::gil_scoped_release release;
     const BinaryVolume volume = binarize(scalar, sel);
-    out.mesh = press_chunked(volume.lattice, "array", [&](const Box& box) { return crop(volume, box); }, o, chunks, &st);
+    r = press_chunked(volume.lattice, "array", [&](const Box& box) { return crop(volume, box); }, o, chunks, &st);
   }
-  out.stats["method"] = "pressing";
+  out.mesh = std::move(r.mesh);
+  out.stats["method"] = std::string(method_name(o.method));
   out.stats["blocks"] = st.blocks;
   out.stats["sticks"] = st.sticks;
   out.stats["vertices"] = out.mesh.vertex_count();
   out.stats["triangles"] = out.mesh.face_count();
-  out.stats["iterations"] = st.max_iterations;
-  out.stats["flats"] = 0;
-  out.stats["keeps_classification"] = true;
+  out.stats["iterations"] = r.press.iterations;
+  out.stats["flats"] = r.flats.flats.size();
+  out.stats["sharp_edges"] = out.mesh.edges.size();
+  out.stats["keeps_classification"] = keeps_classification(o.method);
   out.stats["seconds_blocks"] = st.seconds_blocks;
   out.stats["seconds_stitch"] = st.seconds_stitch;
   return out;
 }
 
 void bind_chunks(py::module_& m) {
-  m.def("chunk_plan", &py_chunk_plan, py::arg("shape"), py::kw_only(), py::arg("chunk") = 256, py::arg("halo") = 24,
+  m.def("chunk_plan", &py_chunk_plan, py::arg("shape"), py::kw_only(), py::arg("chunk") = 256, py::arg("halo") = 0,
         "The blocks of a volume: [{block, core: (lo, hi), read: (lo, hi)}], x fastest.");
   m.def("_press_block", &py_press_block, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
         py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
@@ -167,7 +187,9 @@ void bind_chunks(py::module_& m) {
         "One block's piece (voxpress.dask): mask is the block's read box, non-zero inside; threads 0: all cores.");
   m.def("_stitch", &py_stitch, py::arg("pieces"), py::kw_only(), py::arg("shape"),
         py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
-        py::arg("direction") = py::none(), "The mesh of every block's piece (any order).");
+        py::arg("direction") = py::none(), py::arg("smooth") = false,
+        "The mesh of every block's piece (any order); smooth: the pieces were only extracted (halo 0), "
+        "smooth the stitched sticks with the options (press()'s).");
 }
 
 }  // namespace voxpress::python

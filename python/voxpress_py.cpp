@@ -198,7 +198,7 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
   // ArrayLike: nested lists and anything numpy.asarray takes.
   const py::array mask = py::module_::import("numpy").attr("asarray")(mask_like);
   ScalarVolume scalar = to_volume(mask, spacing, origin, direction, axes);
-  if (chunks) return press_chunked_volume(scalar, sel, o, *chunks);  // flats off, as press --chunk
+  if (chunks) return press_chunked_volume(scalar, sel, o, *chunks);  // as press --chunk [--halo]
   SurfaceResult r;
   double seconds_binarize = 0;
   {

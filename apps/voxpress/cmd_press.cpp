@@ -3,7 +3,10 @@
 #include <tbb/parallel_for.h>
 
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <mutex>
+#include <optional>
 
 #include "common.h"
 
@@ -115,73 +118,73 @@ void write_features(const std::string& path, const Mesh& mesh) {
   write_mesh(path, f);
 }
 
-// press --chunk: block by block (chunk/chunked.h); flats and sharp edges off.
+// The volume's surface, in memory or block by block (--chunk), and how to
+// check a mesh against the volume's samples.
+struct Pressed {
+  SurfaceResult r;
+  Lattice lattice;
+  double seconds_read = 0;
+  std::function<nlohmann::json(const Mesh&, bool strict)> check;
+  std::optional<ChunkedStats> chunks;
+  bool streamed = false;
+};
+
+Pressed press_in_memory(const PressCmd& c, const SurfaceOptions& so, const Global& g, Progress* progress) {
+  Stopwatch clock;
+  auto volume = std::make_shared<const BinaryVolume>(load_binary(c.input, c.in, g));
+  Pressed p;
+  p.seconds_read = clock.seconds();
+  p.r = smooth_surface(*volume, so);
+  p.lattice = volume->lattice;
+  p.check = [=](const Mesh& m, bool strict) { return check_surface(m, *volume, progress, c.method, strict); };
+  return p;
+}
+
 // press --chunk: the file read block by block (VolumeFile streams raw NRRD
 // and .raw; other files are read whole first), an automatic selection
-// resolved on one pass over the blocks, and --check on slabs of planes.
-void run_press_chunked(const PressCmd& c, SurfaceOptions so, const Global& g) {
-  if (so.method != Method::pressing) throw UsageError("--chunk runs --method pressing only");
-  for (const char* name : {"--labels", "--features", "--color-regions", "--min-flat-area", "--junction-angle",
-                           "--sharp-angle", "--no-sharpen"})
-    if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --chunk (no flats across blocks yet)");
+// resolved on one pass over the blocks, --check on slabs of planes.
+Pressed press_chunked_file(const PressCmd& c, const SurfaceOptions& so, const Global& g, Progress* progress) {
+  if (c.chunks.halo > 0)
+    for (const char* name : {"--features", "--color-regions", "--min-flat-area", "--junction-angle", "--sharp-angle",
+                             "--no-sharpen"})
+      if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --halo (blocks pressed apart: no flats)");
   Selection selection = c.in.selection();  // usage errors before any I/O
   Stopwatch clock;
-  ProgressBar bar(!g.quiet);
-  so.progress = bar.get();
-  const VolumeFile file(c.input, c.in.read_options(g));
-  const Lattice& lattice = file.header().lattice;
+  auto file = std::make_shared<const VolumeFile>(c.input, c.in.read_options(g));
+  const Lattice& lattice = file->header().lattice;
   const ChunkGrid grid(lattice.dims, c.chunks);
   if (selection.kind == Selection::Kind::automatic) {  // which value the mask holds: one pass over the blocks
     ValueSummary values;
     std::mutex mu;
-    ProgressCounter progress(so.progress, "values", grid.count());
+    ProgressCounter counter(progress, "values", grid.count());
     tbb::parallel_for(size_t(0), grid.count(), [&](size_t b) {
-      const ValueSummary part = summarize_values(file.read(grid.core(b)));
+      const ValueSummary part = summarize_values(file->read(grid.core(b)));
       std::lock_guard lock(mu);
       values.merge(part);  // min, max, or and a set union: order-independent
-      progress.add(1);
+      counter.add(1);
     });
-    selection = resolve_selection(file.header(), selection, values);
+    selection = resolve_selection(file->header(), selection, values);
   }
-  const double seconds_read = clock.seconds();
-  const BlockReader read = [&](const Box& box) { return select_samples(file.read(box), selection); };
+  Pressed p;
+  p.seconds_read = clock.seconds();
+  const BlockReader read = [file, selection](const Box& box) { return select_samples(file->read(box), selection); };
   ChunkedStats st;
-  const Mesh mesh = press_chunked(lattice, c.input, read, so, c.chunks, &st);
-  const PlaneReader planes = [&](int64_t k0, int64_t k1) {
-    return read(Box{{0, 0, k0}, {lattice.dims[0], lattice.dims[1], k1}});
+  p.r = press_chunked(lattice, c.input, read, so, c.chunks, &st);
+  p.chunks = st;
+  p.lattice = lattice;
+  p.streamed = file->streams();
+  p.check = [=](const Mesh& m, bool strict) {
+    const Lattice& l = file->header().lattice;
+    const PlaneReader planes = [&](int64_t k0, int64_t k1) { return read(Box{{0, 0, k0}, {l.dims[0], l.dims[1], k1}}); };
+    return check_surface(m, l, planes, progress, c.method, strict);
   };
-  const nlohmann::json checks = c.check ? check_surface(mesh, lattice, planes, bar.get(), c.method) : nlohmann::json();
-  MeshWriteOptions wo;
-  wo.ascii = c.ascii;
-  write_mesh(c.output, mesh, wo);
-  if (!g.quiet)
-    std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu blocks of %lld (halo %lld, %zu with surface), %d levels, "
-                 "at most %d iterations; no flats (--chunk)%s\n",
-                 c.output.c_str(), mesh.vertex_count(), mesh.face_count(), st.blocks, (long long)c.chunks.chunk,
-                 (long long)c.chunks.halo, st.pressed, st.levels, st.max_iterations,
-                 file.streams() ? "" : "; the file was read whole (only raw NRRD and .raw stream)");
-  if (!c.stats_json.empty()) {
-    ExtractStats es;
-    es.samples = lattice.size();
-    es.sticks = st.sticks;
-    es.triangles = st.triangles;
-    nlohmann::json j = surface_stats_json("press", c.input, c.output, lattice, es, mesh);
-    j["method"] = c.method;
-    j["chunks"] = {{"chunk", c.chunks.chunk}, {"halo", c.chunks.halo}, {"blocks", st.blocks},
-                   {"blocks_with_surface", st.pressed}, {"levels", st.levels}, {"max_iterations", st.max_iterations},
-                   {"streamed", file.streams()}};
-    j["seconds"] = {{"read", seconds_read}, {"summary", st.seconds_summary}, {"blocks", st.seconds_blocks},
-                    {"stitch", st.seconds_stitch}, {"total", clock.seconds()}};
-    j["peak_memory_bytes"] = peak_rss_bytes();
-    if (c.check) j["checks"] = checks;
-    write_json(c.stats_json, j);
-  }
+  return p;
 }
 
 void run_press(const PressCmd& c, const Global& g) {
   const bool labels = !c.labels.empty();
   if (labels) {
-    for (const char* name : {"--label", "--threshold", "--segment", "--features"})
+    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--chunk", "--halo"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --labels");
     check_paths({c.input}, {{c.stats_json, OutputKind::json}});
   } else {
@@ -228,21 +231,17 @@ void run_press(const PressCmd& c, const Global& g) {
     run_press_labels(c.input, c.in, so, o, g);
     return;
   }
-  if (c.cmd->count("--chunk")) {
-    run_press_chunked(c, so, g);
-    return;
-  }
-  if (c.cmd->count("--halo")) throw UsageError("--halo needs --chunk");
+  if (c.cmd->count("--halo") && !c.cmd->count("--chunk")) throw UsageError("--halo needs --chunk");
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   so.progress = bar.get();
-  const BinaryVolume volume = load_binary(c.input, c.in, g);
-  const double seconds_read = clock.seconds();
-  const SurfaceResult r = smooth_surface(volume, so);
+  const Pressed p = c.cmd->count("--chunk") ? press_chunked_file(c, so, g, bar.get()) : press_in_memory(c, so, g, bar.get());
+  const SurfaceResult& r = p.r;
   const Mesh& mesh = r.mesh;
+  const double seconds_read = p.seconds_read;
   // Methods without the in/out guarantee have their checks reported, not enforced.
   const bool strict = keeps_classification(so.method);
-  const nlohmann::json checks = c.check ? check_surface(mesh, volume, bar.get(), c.method, strict) : nlohmann::json();
+  const nlohmann::json checks = c.check ? p.check(mesh, strict) : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);
@@ -260,10 +259,21 @@ void run_press(const PressCmd& c, const Global& g) {
       std::fprintf(stderr, "%s: %llu samples on the wrong side, %zu self-intersections (%s promises neither)\n",
                    c.output.c_str(), (unsigned long long)checks["classification_violations"].get<uint64_t>(),
                    checks["self_intersections"].get<size_t>(), c.method.c_str());
+    if (p.chunks)
+      std::fprintf(stderr, "%s: %zu blocks of %lld, %s; %s\n", c.output.c_str(), p.chunks->blocks,
+                   (long long)c.chunks.chunk,
+                   c.chunks.halo ? ("pressed apart with a halo of " + std::to_string(c.chunks.halo)).c_str()
+                                 : "stitched and smoothed whole (exact)",
+                   p.streamed ? "read from disk block by block" : "the file was read whole (only raw NRRD and .raw stream)");
   }
   if (!c.stats_json.empty()) {
-    nlohmann::json j = surface_stats_json("press", c.input, c.output, volume.lattice, r.extract, mesh);
+    nlohmann::json j = surface_stats_json("press", c.input, c.output, p.lattice, r.extract, mesh);
     j["method"] = c.method;
+    if (const auto& st = p.chunks)
+      j["chunks"] = {{"chunk", c.chunks.chunk}, {"halo", c.chunks.halo}, {"blocks", st->blocks},
+                     {"blocks_with_surface", st->pressed}, {"streamed", p.streamed},
+                     {"seconds", {{"summary", st->seconds_summary}, {"blocks", st->seconds_blocks},
+                                  {"stitch", st->seconds_stitch}}}};
     if (pressing) {
       j["pressing"] = press_stats_json(r.press, so.press);
       const bool features = so.passes.on(Pass::flats);
@@ -343,12 +353,15 @@ void register_press(CLI::App& app, Global& g) {
                   "layer): " + pass_names)
       ->delimiter(',');
   sh->add_option("--features", c->features, "Also write the sharp curves alone (.ply edges or .obj lines)");
-  auto* ch = cmd->add_option_group("chunks", "Block by block, for volumes larger than memory (no flats)");
-  ch->add_option("--chunk", c->chunks.chunk, "Press blocks of this many samples per side and stitch them")
+  auto* ch = cmd->add_option_group("chunks", "Block by block, for volumes larger than memory");
+  ch->add_option("--chunk", c->chunks.chunk,
+                 "Read the volume in blocks of this many samples per side (raw NRRD / .raw from disk) and stitch "
+                 "their sticks: the same mesh as without, the volume never whole in memory")
       ->check(CLI::Range(int64_t(8), int64_t(1) << 20));
-  ch->add_option("--halo", c->chunks.halo, "Samples each block reads beyond its own on every side")
-      ->check(CLI::Range(int64_t(1), int64_t(256)))
-      ->capture_default_str();
+  ch->add_option("--halo", c->chunks.halo,
+                 "Also press each block apart, reading this many samples around it (memory: one block's surface; "
+                 "Pressing only, no flats; vertices near block borders move, docs/BENCHMARKS.md)")
+      ->check(CLI::Range(int64_t(1), int64_t(256)));
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");

@@ -249,11 +249,11 @@ nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progr
 }
 
 nlohmann::json check_surface(const Mesh& mesh, const Lattice& lattice, const PlaneReader& planes, Progress* progress,
-                             const std::string& what) {
+                             const std::string& what, bool strict) {
   const MeshCheck mc = check_mesh(mesh);
   ClassificationOptions co;
   co.progress = progress;
-  return report_checks(mc, check_classification(mesh, lattice, planes, co), what, true);
+  return report_checks(mc, check_classification(mesh, lattice, planes, co), what, strict);
 }
 
 void PlacementCli::bind(CLI::App& cmd, const std::string& what) {

@@ -108,7 +108,7 @@ nlohmann::json check_surface(const Mesh& mesh, const BinaryVolume& volume, Progr
                              bool strict = true);
 /// The same with the volume read a slab of planes at a time (press --chunk).
 nlohmann::json check_surface(const Mesh& mesh, const Lattice& lattice, const PlaneReader& planes, Progress* progress,
-                             const std::string& what);
+                             const std::string& what, bool strict = true);
 
 /// --res --rotate --spacing --margin: how generate and voxelize place a solid
 /// on a new lattice (GenerateOptions and VoxelizeOptions share these fields).

@@ -39,20 +39,24 @@ def _block(mask, **kw):
     return _voxpress._press_block(np.asarray(mask), **kw)
 
 
-def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
-          label=None, threshold=None, client=None, threads=0, iterations=None, tolerance=None, fit_rings=None):
+def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
+          label=None, threshold=None, client=None, threads=0, **options):
     """The smooth surface of a Dask, Zarr or numpy array, block by block on Dask; returns a Mesh.
 
     array: indexed array[i, j, k] (x first); a zarr array is wrapped with
     dask.array.from_zarr. Inside: non-zero samples (a bool mask as is);
-    label=N takes array == N, threshold=T array >= T. spacing, origin and
-    direction are press()'s. chunk and halo are `press --chunk N --halo H`
-    (docs/BENCHMARKS.md, Chunked: halo 24 keeps vertices within ~0.01 cell
-    of the whole-volume run). client: a dask.distributed Client; None uses
-    Dask's current scheduler (a Client you created, else threads). threads:
-    cores one block task uses (0: all the worker's machine has; set it to
-    the worker's threads when several workers share a machine). The result
-    does not depend on it.
+    label=N takes array == N, threshold=T array >= T. spacing, origin,
+    direction and the options (iterations, flats, sharpen, ...) are press()'s.
+    halo=0 (exact): the workers extract their blocks' sticks and the caller
+    smooths the stitched surface: `voxpress press` byte for byte, flats and
+    sharp edges included; the caller holds the surface, never the volume.
+    halo=H: the workers press their blocks too, reading H samples around
+    them (`press --chunk N --halo H`): no process holds more than a block's
+    surface; Pressing only (flats off); vertices near block borders move
+    (docs/BENCHMARKS.md, Chunked). client: a dask.distributed Client; None
+    uses Dask's current scheduler (a Client you created, else threads).
+    threads: cores one block task uses (0: all its machine's; set it to the
+    worker's threads when several workers share a machine).
     """
     import dask
     import dask.array as da
@@ -77,8 +81,7 @@ def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
                                    "grid's bounding box (check label / threshold)")
     lo = [int(np.flatnonzero(c)[0]) for c in counts]
     hi = [int(np.flatnonzero(c)[-1]) + 1 for c in counts]
-    options = {k: v for k, v in dict(iterations=iterations, tolerance=tolerance, fit_rings=fit_rings).items()
-               if v is not None}
+    options = {k: v for k, v in options.items() if v is not None}
     plan = _voxpress.chunk_plan(shape, chunk=chunk, halo=halo)
     block = dask.delayed(_block, pure=True)
     tasks = []
@@ -86,11 +89,10 @@ def press(array, *, chunk=256, halo=24, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
         (x0, y0, z0), (x1, y1, z1) = b["read"]
         tasks.append(block(inside[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, halo=halo,
                            bounds=(lo, hi), spacing=spacing, origin=origin, direction=direction, threads=threads,
-                           **options))
+                           **(options if halo else {})))
     if client is not None:
         pieces = client.gather(client.compute(tasks))
     else:
         pieces = dask.compute(*tasks)
-    mesh = _voxpress._stitch(list(pieces), shape=shape, spacing=spacing, origin=origin, direction=direction)
-    mesh.stats["max_iterations"] = max(p["iterations"] for p in pieces)
-    return mesh
+    return _voxpress._stitch(list(pieces), shape=shape, spacing=spacing, origin=origin, direction=direction,
+                             smooth=not halo, **(options if not halo else {}))

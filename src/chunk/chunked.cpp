@@ -51,7 +51,7 @@ uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t,
 
 ChunkGrid::ChunkGrid(const std::array<int64_t, 3>& d, const ChunkOptions& o) : dims(d), chunk(o.chunk), halo(o.halo) {
   if (chunk < kMinChunk) throw UsageError("--chunk must be at least " + std::to_string(kMinChunk) + " samples");
-  if (halo < 1 || halo > kMaxHalo) throw UsageError("the halo must be in [1, " + std::to_string(kMaxHalo) + "] samples");
+  if (halo < 0 || halo > kMaxHalo) throw UsageError("the halo must be in [0, " + std::to_string(kMaxHalo) + "] samples");
   for (int a = 0; a < 3; ++a) n_[size_t(a)] = (dims[size_t(a)] + chunk - 1) / chunk;
 }
 
@@ -67,9 +67,10 @@ Box ChunkGrid::core(size_t b) const {
 
 Box ChunkGrid::with_halo(size_t b) const {
   Box box = core(b);
+  const int64_t h = std::max<int64_t>(halo, 1);  // extraction's own reach: the owned cubes' upper samples
   for (int a = 0; a < 3; ++a) {
-    box.lo[size_t(a)] = std::max<int64_t>(0, box.lo[size_t(a)] - halo);
-    box.hi[size_t(a)] = std::min(dims[size_t(a)], box.hi[size_t(a)] + halo);
+    box.lo[size_t(a)] = std::max<int64_t>(0, box.lo[size_t(a)] - h);
+    box.hi[size_t(a)] = std::min(dims[size_t(a)], box.hi[size_t(a)] + h);
   }
   return box;
 }
@@ -134,7 +135,7 @@ SurfaceOptions chunk_surface_options(const SurfaceOptions& options, const Volume
   return o;
 }
 
-SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_t b, const SurfaceOptions& options) {
+SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_t b, const SurfaceOptions* options) {
   const Box read = grid.with_halo(b), core = grid.core(b);
   const auto& dims = grid.dims;
   if (block.lattice.dims != read.dims() || block.inside.size() != read.size())
@@ -148,10 +149,12 @@ SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_
   for (size_t a = 0; a < 3; ++a) touches_border |= read.lo[a] == 0 || read.hi[a] == dims[a];
   if (inside == block.lattice.size() && !touches_border) return out;  // its only sticks are the read box's faces
 
-  StickSurface s = extract_sticks(block, options.extract);
-  SurfaceResult r;
-  press_stick_surface(s, options, r);
-  out.press = r.press;
+  StickSurface s = extract_sticks(block, options ? options->extract : ExtractOptions{});
+  if (options) {
+    SurfaceResult r;
+    press_stick_surface(s, *options, r);
+    out.press = r.press;
+  }
 
   auto global_lower = [&](size_t id) {
     auto l = s.lower_index(id);
@@ -274,9 +277,11 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
   return out;
 }
 
-Mesh press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
-                   const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats) {
-  if (options.method != Method::pressing) throw UsageError("--chunk runs --method pressing only");
+SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
+                            const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats) {
+  const bool exact = chunks.halo == 0;
+  if (!exact && options.method != Method::pressing)
+    throw UsageError("blocks pressed on their own (a halo) run --method pressing only");
   validate(options);
   require_float32_room(lattice, options, source);
   const ChunkGrid grid(lattice.dims, chunks);
@@ -309,7 +314,7 @@ Mesh press_chunked(const Lattice& lattice, const std::string& source, const Bloc
 
   t0 = std::chrono::steady_clock::now();
   const SurfaceOptions so = chunk_surface_options(options, summary);
-  st.levels = so.press.levels;
+  if (!exact) st.levels = so.press.levels;
   std::vector<SurfacePiece> pieces(grid.count());
   {
     ProgressCounter progress(options.progress, "blocks", grid.count());
@@ -321,7 +326,7 @@ Mesh press_chunked(const Lattice& lattice, const std::string& source, const Bloc
           throw std::logic_error("press_chunked: the reader returned the wrong box");
         block.lattice = box_lattice(lattice, box);
         block.source = source;
-        pieces[b] = press_block(block, grid, b, so);
+        pieces[b] = press_block(block, grid, b, exact ? nullptr : &so);
         progress.add(1);
       }
     });
@@ -335,12 +340,26 @@ Mesh press_chunked(const Lattice& lattice, const std::string& source, const Bloc
   t0 = std::chrono::steady_clock::now();
   StickSurface surface = stitch(lattice, pieces);
   pieces = {};
-  Mesh mesh = to_mesh(surface);
   st.sticks = surface.stick_count();
   st.triangles = surface.triangles.size();
   st.seconds_stitch = seconds_since(t0);
+  SurfaceResult r;
+  r.extract.samples = lattice.size();
+  r.extract.sticks = st.sticks;
+  r.extract.triangles = st.triangles;
+  r.seconds_extract = st.seconds_summary + st.seconds_blocks + st.seconds_stitch;
+  if (exact) {
+    // The whole volume's sticks, exactly: the rest of smooth_surface on them.
+    r = smooth_sticks(std::move(surface), options, std::move(r));
+    st.levels = r.press.levels;
+    st.max_iterations = r.press.iterations;
+  } else {
+    r.mesh = to_mesh(surface);
+    r.press.iterations = st.max_iterations;
+    r.press.levels = st.levels;
+  }
   if (stats) *stats = st;
-  return mesh;
+  return r;
 }
 
 }  // namespace voxpress

@@ -146,7 +146,6 @@ void press_stick_surface(StickSurface& surface, const SurfaceOptions& o, Surface
 }
 
 SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
-  const MethodOverrides& ov = o.overrides;
   validate(o);
   require_mixed(volume);
   require_float32_room(volume.lattice, o, volume.source);
@@ -157,7 +156,13 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   eo.later_bytes_per_stick = std::max(eo.later_bytes_per_stick, bytes_per_stick(o));
   StickSurface surface = extract_sticks(volume, eo, &r.extract);
   r.seconds_extract = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
+  return smooth_sticks(std::move(surface), o, std::move(r));
+}
+
+SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, SurfaceResult r) {
+  const MethodOverrides& ov = o.overrides;
+  validate(o);
+  const auto t0 = std::chrono::steady_clock::now();
   switch (o.method) {
     case Method::pressing: {
       press_stick_surface(surface, o, r);

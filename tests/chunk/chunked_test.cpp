@@ -22,7 +22,7 @@ Mesh chunked(const BinaryVolume& v, int64_t chunk, int64_t halo, const SurfaceOp
   ChunkOptions c;
   c.chunk = chunk;
   c.halo = halo;
-  return press_chunked(v.lattice, v.source, [&](const Box& b) { return crop(v, b); }, o, c, st);
+  return press_chunked(v.lattice, v.source, [&](const Box& b) { return crop(v, b); }, o, c, st).mesh;
 }
 
 // The whole-volume run with the chunked run's options (flats off).
@@ -63,7 +63,9 @@ TEST(Chunked, GridCoversTheVolumeOnce) {
   }
   EXPECT_EQ(covered, 37u * 8u * 20u);
   EXPECT_THROW(ChunkGrid({8, 8, 8}, {.chunk = 4, .halo = 1}), UsageError);
-  EXPECT_THROW(ChunkGrid({8, 8, 8}, {.chunk = 8, .halo = 0}), UsageError);
+  EXPECT_THROW(ChunkGrid({8, 8, 8}, {.chunk = 8, .halo = -1}), UsageError);
+  EXPECT_THROW(ChunkGrid({8, 8, 8}, {.chunk = 8, .halo = 257}), UsageError);
+  EXPECT_EQ(ChunkGrid({16, 8, 8}, {.chunk = 8, .halo = 0}).with_halo(0).hi[0], 9);  // exact mode reads one more sample
 }
 
 TEST(Chunked, OneBlockIsTheWholeRunBitForBit) {
@@ -75,6 +77,36 @@ TEST(Chunked, OneBlockIsTheWholeRunBitForBit) {
     const Mesh a = whole(s.volume), b = chunked(s.volume, 64, 4);
     EXPECT_EQ(a.triangles, b.triangles);
     EXPECT_EQ(a.positions, b.positions);
+  }
+}
+
+TEST(Chunked, ExactModeIsTheWholeRunByteForByte) {
+  // Halo 0: blocks only extracted, the stitched sticks smoothed at once, so
+  // every stage (flats, junctions, sharp edges) sees the whole volume's
+  // sticks: the same mesh, attributes included, for any block size.
+  GenerateOptions g;
+  g.res = 48;
+  g.rotation = parse_rotation("random:3");
+  Rng rng(5);
+  std::vector<std::pair<std::string, BinaryVolume>> cases;
+  cases.emplace_back("cad part", generate_shape(ShapeKind::cad_part, g).volume);
+  cases.emplace_back("box", generate_shape(ShapeKind::box, g).volume);
+  cases.emplace_back("noise", test::random_noise(rng, {21, 17, 19}, 0.5));
+  cases.emplace_back("checkerboard", test::checkerboard({17, 16, 18}));
+  for (const auto& [name, v] : cases) {
+    const SurfaceResult a = smooth_surface(v, {});
+    for (int64_t chunk : {8, 12}) {
+      SCOPED_TRACE(name + " chunk " + std::to_string(chunk));
+      ChunkedStats st;
+      const Mesh b = chunked(v, chunk, 0, {}, &st);
+      EXPECT_EQ(a.mesh.positions, b.positions);
+      EXPECT_EQ(a.mesh.triangles, b.triangles);
+      EXPECT_EQ(a.mesh.edges, b.edges);
+      ASSERT_EQ(a.mesh.vertex_attributes.size(), b.vertex_attributes.size());
+      for (size_t i = 0; i < b.vertex_attributes.size(); ++i)
+        EXPECT_EQ(a.mesh.vertex_attributes[i].values, b.vertex_attributes[i].values);
+      EXPECT_GT(st.blocks, 1u);
+    }
   }
 }
 
@@ -142,7 +174,7 @@ TEST(Chunked, SameBytesForAnyThreadCountAndPieceOrder) {
   summary.add(s.volume, Box{{0, 0, 0}, s.volume.lattice.dims});
   const SurfaceOptions so = chunk_surface_options(plain(), summary);
   std::vector<SurfacePiece> pieces;
-  for (size_t b = grid.count(); b-- > 0;) pieces.push_back(press_block(crop(s.volume, grid.with_halo(b)), grid, b, so));
+  for (size_t b = grid.count(); b-- > 0;) pieces.push_back(press_block(crop(s.volume, grid.with_halo(b)), grid, b, &so));
   const Mesh reversed = to_mesh(stitch(s.volume.lattice, pieces));
   EXPECT_EQ(reversed.positions, many.positions);
   EXPECT_EQ(reversed.triangles, many.triangles);
@@ -153,7 +185,7 @@ TEST(Chunked, SameBytesForAnyThreadCountAndPieceOrder) {
   pieces.pop_back();
   EXPECT_THROW(stitch(s.volume.lattice, pieces), UsageError);
   // A triangle naming a stick no piece owns is refused.
-  pieces.push_back(press_block(crop(s.volume, grid.with_halo(0)), grid, 0, so));
+  pieces.push_back(press_block(crop(s.volume, grid.with_halo(0)), grid, 0, &so));
   stitch(s.volume.lattice, pieces);
   const uint64_t absent = stick_key(s.volume.lattice.dims, {1, 1, 1}, 0);  // sample (0, 0, 0) is outside the part
   for (int v = 0; v < 3; ++v) pieces.back().triangles.push_back(absent);

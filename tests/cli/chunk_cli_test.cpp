@@ -1,7 +1,7 @@
 // press --chunk from the command line: a raw NRRD streamed block by block
 // and the same samples gzip-compressed (read whole) write the same bytes,
-// pass --check, resolve an automatic selection over the whole file, and bad
-// options leave no output file.
+// without a halo the bytes of `press` itself, pass --check, resolve an
+// automatic selection over the whole file, and bad options leave no output.
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -35,6 +35,11 @@ TEST(ChunkCli, StreamedAndWholeFilesWriteTheSameCheckedBytes) {
   const std::string a = test::read_file(tmp.path("raw.ply")), b = test::read_file(tmp.path("gz.ply"));
   EXPECT_FALSE(a.empty());
   EXPECT_TRUE(a == b) << "the streamed and the whole file's meshes differ";
+  // Without a halo (exact): `press` on the whole volume, byte for byte, flats and sharp edges included.
+  ASSERT_EQ(run_cli("-q press " + tmp.path("gz.nrrd") + " -o " + tmp.path("whole.ply"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q press " + tmp.path("raw.nrrd") + " --chunk 16 --check -o " + tmp.path("exact.ply"), &out), 0) << out;
+  EXPECT_TRUE(test::read_file(tmp.path("whole.ply")) == test::read_file(tmp.path("exact.ply")));
+  EXPECT_FALSE(test::read_file(tmp.path("whole.ply")) == a);  // the halo run differs near block borders
   // 1 and 2 threads: the same bytes.
   ASSERT_EQ(run_cli("-q --threads 1 press " + tmp.path("raw.nrrd") + " --chunk 16 --halo 6 -o " + tmp.path("one.ply")), 0);
   EXPECT_TRUE(test::read_file(tmp.path("one.ply")) == a);
@@ -61,7 +66,7 @@ TEST(ChunkCli, SelectionsResolveOverTheWholeFileAndBadOptionsWriteNothing) {
   EXPECT_NE(out.find("empty"), std::string::npos) << out;
   EXPECT_EQ(run_cli("-q press " + in + " --halo 4" + o, &out), 2);
   EXPECT_EQ(run_cli("-q press " + in + " --chunk 4" + o, &out), 2);
-  EXPECT_EQ(run_cli("-q press " + in + " --chunk 10 --no-sharpen" + o, &out), 2);
+  EXPECT_EQ(run_cli("-q press " + in + " --chunk 10 --halo 4 --no-sharpen" + o, &out), 2);
   EXPECT_EQ(run_cli("-q press " + tmp.path("absent.nrrd") + " --chunk 10" + o, &out), 1);
   EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
   // --label 2 streamed equals --label 2 on a mask of label 2 alone.

@@ -30,6 +30,13 @@ def test_chunked_press_is_the_clis(tmp_path):
     assert mesh.stats["blocks"] == len(voxpress.chunk_plan(data.shape, chunk=16, halo=5))
     assert voxpress.check(mesh, data, spacing=lattice.spacing, origin=lattice.origin,
                           direction=lattice.direction)["ok"]
+    # Without a halo (exact): the whole run's bytes, flats and sharp edges included.
+    whole = voxpress.press(data, spacing=lattice.spacing, origin=lattice.origin, direction=lattice.direction)
+    exact = voxpress.press(data, spacing=lattice.spacing, origin=lattice.origin, direction=lattice.direction, chunk=16)
+    np.testing.assert_array_equal(exact.vertices, whole.vertices)
+    np.testing.assert_array_equal(exact.faces, whole.faces)
+    np.testing.assert_array_equal(exact.sharp_edges, whole.sharp_edges)
+    assert exact.stats["flats"] == whole.stats["flats"] > 0
     with pytest.raises(voxpress.UsageError):
         voxpress.press(data, halo=5)
     with pytest.raises(voxpress.UsageError):
@@ -56,7 +63,7 @@ def sphere(n, seed=1):
 
 
 def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
-    dask = pytest.importorskip("dask")
+    pytest.importorskip("dask")
     distributed = pytest.importorskip("distributed")
     import dask.array as da
 
@@ -64,19 +71,21 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
 
     mask = sphere(256)
     spacing, origin = (0.8, 0.8, 1.2), (-3.0, 4.0, 10.0)
-    ref = voxpress.press(mask, spacing=spacing, origin=origin, chunk=128, halo=24)
+    ref = voxpress.press(mask, spacing=spacing, origin=origin)  # the whole run: exact mode gives its bytes
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         array = da.from_array(mask.astype(np.uint8), chunks=96)  # Dask's chunks need not be the blocks
-        mesh = voxpress.dask.press(array, chunk=128, halo=24, spacing=spacing, origin=origin, client=client)
+        mesh = voxpress.dask.press(array, chunk=128, spacing=spacing, origin=origin, client=client)
     np.testing.assert_array_equal(mesh.faces, ref.faces)
     np.testing.assert_array_equal(mesh.vertices, ref.vertices)
     assert mesh.stats["blocks"] == 8
     assert voxpress.check(mesh)["ok"]
-    # The threaded scheduler (no client) and a label selection: the same again.
-    labels = np.where(mask, 3, 0).astype(np.int16)
-    again = voxpress.dask.press(da.from_array(labels[100:164, 100:164, 20:84], chunks=32), chunk=32, halo=8, label=3)
-    small = voxpress.press(mask[100:164, 100:164, 20:84], chunk=32, halo=8)
+    # Blocks pressed on the workers (a halo), the threaded scheduler, a label:
+    # the in-process run with the same halo.
+    labels = np.where(mask, 3, 0).astype(np.int16)[100:164, 100:164, 20:84]
+    again = voxpress.dask.press(da.from_array(labels, chunks=32), chunk=32, halo=8, label=3)
+    small = voxpress.press(labels == 3, chunk=32, halo=8)
     np.testing.assert_array_equal(again.vertices, small.vertices)
+    np.testing.assert_array_equal(again.faces, small.faces)
     with pytest.raises(voxpress.InputError):
         voxpress.dask.press(da.zeros((32, 32, 32), chunks=16), chunk=16)

@@ -1,26 +1,32 @@
-// voxpress/chunk/chunked.h — Pressing block by block: volumes larger than
-// memory (`press --chunk`) and larger than one machine (voxpress.dask).
+// voxpress/chunk/chunked.h — block by block: volumes larger than memory
+// (`press --chunk`) and larger than one machine (voxpress.dask).
 //
 // The volume is cut into blocks of `chunk` samples per side. A block is read
-// with `halo` more samples on every side (clipped at the volume), pressed on
-// its own, and keeps only what it owns:
+// with max(halo, 1) more samples on every side (clipped at the volume) and
+// keeps only what it owns:
 //   - a stick, when its lower sample, clamped into the volume, lies in the
 //     block's core (a stick from the outside layer below the volume belongs
 //     to the block holding sample 0);
 //   - a cube's triangles, when the cube's lower corner, clamped the same way,
 //     lies in the core.
 // Every owned stick and cube lies at least one sample inside the block's
-// read box (halo >= 1), so the block sees its true samples: the stitched
-// surface has exactly the sticks, triangles and order of the whole-volume
-// run (stick s = whole-run stick s), and only the t of sticks near block
-// borders differs, by what the halo leaves of the block's artificial border
-// (docs/BENCHMARKS.md, Chunked). Pieces name sticks by global keys, so
-// stitching is a sort and a lookup: no welding, no duplicate, no crack.
+// read box, so the block sees its true samples: the stitched surface has
+// exactly the sticks, triangles and order of the whole-volume run (stick s
+// = whole-run stick s). Pieces name sticks by global keys, so stitching is a
+// sort and a lookup: no welding, no duplicate, no crack.
 //
-// What differs from the whole-volume run: flats and sharp edges are off (a
-// plane crossing block borders would need one vote over all blocks), and
-// coarse-to-fine levels come from the whole volume's extent, so a block
-// presses with the same stages as the whole run.
+// Two modes. Exact (halo 0): blocks are only extracted, and smoothing runs
+// once on the stitched sticks, which is all smooth_surface's stages read:
+// the whole-volume result byte for byte (flats and sharp edges included),
+// with the volume never in memory. Pressing's reach is global (its
+// coarse-to-fine stages move information hundreds of cells, and on a
+// plane nothing stops it), so no halo makes blocks pressed apart exact.
+// Halo (>= 1): each block is pressed on its own too, for surfaces larger
+// than one process (Dask workers); only the t of sticks near block borders
+// differs, by what the halo leaves of the block's artificial border
+// (docs/BENCHMARKS.md, Chunked). Flats are off in that mode (a plane across
+// blocks would need one vote over all of them); levels come from the whole
+// volume's extent, so a block presses with the whole run's stages.
 #pragma once
 
 #include <array>
@@ -37,20 +43,26 @@ namespace voxpress {
 
 struct ChunkOptions {
   int64_t chunk = 256;  ///< block side, samples (>= 8)
-  /// Samples read beyond the block on every side (>= 1): enough for
-  /// Pressing's reach that a stitched vertex differs from the whole-volume
-  /// run by at most ~0.01 cell (measured per width: docs/BENCHMARKS.md).
-  int64_t halo = 24;
+  /// 0 (exact): blocks are read with one sample around them and only
+  /// extracted; their sticks, stitched, are the whole volume's, and the rest
+  /// of smooth_surface runs on them (any method, flats and sharp edges too):
+  /// the whole-volume result byte for byte, in memory bounded by the surface
+  /// and one block, not by the volume.
+  /// >= 1: each block is also pressed on its own, reading this many samples
+  /// beyond it (voxpress.dask's workers): memory bounded by one block's
+  /// surface; Pressing only, flats off; vertices near block borders differ
+  /// from the whole run (per width: docs/BENCHMARKS.md, Chunked).
+  int64_t halo = 0;
 };
 
 /// The blocks of a volume, x fastest then y then z.
 struct ChunkGrid {
   std::array<int64_t, 3> dims{};  ///< the volume's samples per axis
-  int64_t chunk = 256, halo = 24;
+  int64_t chunk = 256, halo = 0;
   ChunkGrid(const std::array<int64_t, 3>& dims, const ChunkOptions& o);
   size_t count() const { return size_t(n_[0] * n_[1] * n_[2]); }
   Box core(size_t b) const;       ///< the samples block b owns
-  Box with_halo(size_t b) const;  ///< core grown by halo, clipped to the volume
+  Box with_halo(size_t b) const;  ///< core grown by max(halo, 1), clipped to the volume
 
  private:
   std::array<int64_t, 3> n_{};  // blocks per axis
@@ -80,9 +92,12 @@ struct SurfacePiece {
 /// ((r * (ny + 2) + q) * 3 + a) * (nx + 2) + p.
 uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& padded_lower, int axis);
 
-/// Presses block b of `grid`: `samples` holds grid.with_halo(b) (its
-/// lattice's dims must match). options as chunk_surface_options returns them.
-SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options);
+/// Block b's piece of the surface: `samples` holds grid.with_halo(b) (its
+/// lattice's dims must match). With options (as chunk_surface_options
+/// returns them) the block is pressed; without, its sticks keep the
+/// midpoint t (the exact mode's extraction).
+SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b,
+                         const SurfaceOptions* options);
 
 /// Joins the blocks' pieces into the whole volume's stick surface (any piece
 /// order; deterministic). Throws UsageError unless the pieces are each block
@@ -102,10 +117,11 @@ struct ChunkedStats {
 using BlockReader = std::function<BinaryVolume(const Box&)>;
 
 /// The chunked run: summary pass, blocks (in parallel, each read once with
-/// its halo), stitch. `lattice` is the whole volume's; `source` names it in
+/// its halo), stitch, and in the exact mode (halo 0) smooth_sticks on the
+/// stitched sticks. `lattice` is the whole volume's; `source` names it in
 /// errors. Refuses empty and full volumes like smooth_surface.
-Mesh press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
-                   const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats = nullptr);
+SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
+                            const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats = nullptr);
 
 /// The samples of `box` of an in-memory volume.
 BinaryVolume crop(const BinaryVolume& volume, const Box& box);

@@ -110,4 +110,10 @@ void press_stick_surface(StickSurface& surface, const SurfaceOptions& options, S
 /// options.extract.max_bytes would be exceeded.
 SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& options = {});
 
+/// What smooth_surface does after extraction, on a volume's stick surface
+/// (the whole volume's: every stage reads the sticks, never the samples).
+/// press_chunked's exact mode runs it on the sticks stitched from blocks.
+/// r carries what the caller measured before (extract stats and seconds).
+SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& options, SurfaceResult r = {});
+
 }  // namespace voxpress
