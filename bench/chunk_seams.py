@@ -39,16 +39,30 @@ def run(args):
 
 
 def read_ply(path):
-    """Vertices (float64) and faces of a binary little-endian PLY as voxpress writes it."""
+    """Vertices (float64 x, y, z) and triangles of a binary little-endian PLY
+    as voxpress writes it, whatever other per-vertex and per-face properties
+    (region, junction, colours) it carries."""
     b = pathlib.Path(path).read_bytes()
     i = b.index(b"end_header\n") + len(b"end_header\n")
-    head = b[:i].decode().split("\n")
-    nv = int(next(l for l in head if l.startswith("element vertex")).split()[2])
-    nf = int(next(l for l in head if l.startswith("element face")).split()[2])
-    vtype = "<f8" if "property double x" in head else "<f4"
-    v = np.frombuffer(b, dtype=vtype, count=nv * 3, offset=i).reshape(-1, 3).astype(np.float64)
-    f = np.frombuffer(b, dtype=np.dtype([("n", "u1"), ("i", "<i4", 3)]), count=nf, offset=i + nv * 3 * np.dtype(vtype).itemsize)
-    return v, f["i"]
+    kinds = {"double": "<f8", "float": "<f4", "uchar": "u1", "char": "i1", "ushort": "<u2", "short": "<i2",
+             "uint": "<u4", "int": "<i4"}
+    elements, current = [], None
+    for line in b[:i].decode().split("\n"):
+        w = line.split()
+        if w[:1] == ["element"]:
+            current = [w[1], int(w[2]), []]
+            elements.append(current)
+        elif w[:1] == ["property"] and w[1] == "list":  # the face's vertex list: uchar count, 3 int indices
+            current[2] += [("n", kinds[w[2]]), ("i", kinds[w[3]], 3)]
+        elif w[:1] == ["property"]:
+            current[2].append((w[2], kinds[w[1]]))
+    out, offset = {}, i
+    for name, count, fields in elements:
+        dt = np.dtype(fields)
+        out[name] = np.frombuffer(b, dtype=dt, count=count, offset=offset)
+        offset += count * dt.itemsize
+    v = out["vertex"]
+    return np.stack([v["x"], v["y"], v["z"]], axis=1).astype(np.float64), out["face"]["i"]
 
 
 def write_nrrd(path, mask):
@@ -80,7 +94,7 @@ def main():
     args = ap.parse_args()
     wanted = args.inputs.split(",")
     chunks = [int(c) for c in args.chunks.split(",")]
-    halos = [int(h) for h in args.halos.split(",")]
+    halos = [int(h) for h in args.halos.split(",") if h]
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="voxpress_seams_"))
     inputs = []
     for shape in [s for s in ["sphere", "cad-part"] if s in wanted]:

@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Throughput of voxpress.dask.press (issue 56) on a dask.distributed
 LocalCluster: voxels/s and triangles/s for 1 and 2 worker processes of one
-thread each (each block task uses its worker's one core), and for one worker
-whose tasks use every core; the in-process `press(chunk=)` for reference.
-Every run's mesh is compared with the in-process one (same bytes).
+thread each (each block task uses its worker's one core), in both modes
+(exact: the workers extract, the caller smooths the whole surface; halo:
+the workers press their blocks too); the in-process `press(chunk=)` of
+the same mode for reference, and whether Dask's mesh has its bytes.
 
-    PYTHONPATH=build/python python3 bench/dask_throughput.py [--n 512] [--chunk 128] [--runs 2]
+    PYTHONPATH=build/python python3 bench/dask_throughput.py [--n 512] [--chunk 128] [--runs 1]
 """
 import argparse
 import statistics
@@ -27,35 +28,37 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=512)
     ap.add_argument("--chunk", type=int, default=128)
-    ap.add_argument("--runs", type=int, default=2)
+    ap.add_argument("--runs", type=int, default=1)
     args = ap.parse_args()
     import dask.array as da
     import distributed
 
     mask = sphere(args.n)
     voxels = mask.size
-    t0 = time.perf_counter()
-    ref = voxpress.press(mask, chunk=args.chunk)
-    base = time.perf_counter() - t0
-    tri = len(ref.faces)
-    rows = [("in-process `press(chunk=)`, all cores", base, True)]
     array = da.from_array(mask, chunks=args.chunk)
-    for workers, threads in [(1, 1), (2, 1), (1, 2)]:
-        with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                      dashboard_address=None) as cluster, distributed.Client(cluster) as client:
-            times, same = [], True
-            for _ in range(args.runs):
-                t0 = time.perf_counter()
-                mesh = voxpress.dask.press(array, chunk=args.chunk, client=client, threads=threads)
-                times.append(time.perf_counter() - t0)
-                same &= bool(np.array_equal(mesh.vertices, ref.vertices) and np.array_equal(mesh.faces, ref.faces))
-        rows.append((f"Dask, {workers} worker process{'es' if workers > 1 else ''}, {threads} thread{'s' if threads > 1 else ''} per task",
-                     statistics.median(times), same))
-    print(f"{args.n}³ rotated ellipsoid mask, blocks of {args.chunk} (exact mode: workers extract, the caller smooths), {tri} triangles:\n")
-    print("| run | time | voxels/s | triangles/s | same bytes |")
-    print("|---|---:|---:|---:|---|")
-    for name, t, same in rows:
-        print(f"| {name} | {t:.1f} s | {voxels / t / 1e6:.0f} M | {tri / t / 1e6:.2f} M | {'yes' if same else 'NO'} |")
+    print(f"{args.n}³ rotated ellipsoid mask, blocks of {args.chunk}:\n")
+    print("| mode | run | time | voxels/s | triangles/s | same bytes as in-process |")
+    print("|---|---|---:|---:|---:|---|")
+    for mode, halo in [("exact (workers extract, the caller smooths)", 0), ("halo 32 (workers press)", 32)]:
+        t0 = time.perf_counter()
+        ref = voxpress.press(mask, chunk=args.chunk, halo=halo)
+        base = time.perf_counter() - t0
+        tri = len(ref.faces)
+        rows = [("in-process `press(chunk=)`, all cores", base, True)]
+        for workers in [1, 2]:
+            with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                          dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+                times, same = [], True
+                for _ in range(args.runs):
+                    t0 = time.perf_counter()
+                    mesh = voxpress.dask.press(array, chunk=args.chunk, halo=halo, client=client, threads=1)
+                    times.append(time.perf_counter() - t0)
+                    same &= bool(np.array_equal(mesh.vertices, ref.vertices) and np.array_equal(mesh.faces, ref.faces))
+            rows.append((f"Dask, {workers} worker process{'es' if workers > 1 else ''} of 1 thread",
+                         statistics.median(times), same))
+        for name, t, same in rows:
+            print(f"| {mode} | {name} | {t:.1f} s | {voxels / t / 1e6:.1f} M | {tri / t / 1e6:.3f} M | "
+                  f"{'yes' if same else 'NO'} |", flush=True)
 
 
 if __name__ == "__main__":

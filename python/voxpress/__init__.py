@@ -50,8 +50,9 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
       disable_passes  names of feature-layer passes to switch off, e.g.
                      ["curved-creases"] (the list: voxpress press --help)
       lambda_, mu  Taubin / Laplacian steps
-      chunk, halo  press block by block, as `press --chunk N --halo H` (flats
-                   off; halo 24 by default); voxpress.dask runs the blocks on Dask
+      chunk, halo  block by block, as `press --chunk N [--halo H]`: without a
+                   halo the same mesh; with one, blocks pressed apart (no
+                   flats); voxpress.dask runs the blocks on Dask
     Out-of-range values raise UsageError with the command line's message; the
     GIL is released while it works.
     """

@@ -73,7 +73,7 @@ def press(
     lambda_: float = ...,
     mu: float = ...,
     chunk: Optional[int] = None,
-    halo: int = 24,
+    halo: int = 0,
 ) -> Mesh:
     """The smooth surface of a 3-D mask, as `voxpress press` computes it.
 
@@ -88,7 +88,7 @@ def press(
     direction of index axis a. The GIL is released while it works.
     """
 
-def chunk_plan(shape: Sequence[int], *, chunk: int = 256, halo: int = 24) -> list[dict[str, Any]]:
+def chunk_plan(shape: Sequence[int], *, chunk: int = 256, halo: int = 0) -> list[dict[str, Any]]:
     """The blocks of a volume, x fastest: [{"block": b, "core": (lo, hi), "read": (lo, hi)}] (voxpress.dask)."""
     ...
 
