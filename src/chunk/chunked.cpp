@@ -349,6 +349,13 @@ SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, c
   r.extract.triangles = st.triangles;
   r.seconds_extract = st.seconds_summary + st.seconds_blocks + st.seconds_stitch;
   if (exact) {
+    // The cap smooth_surface's extraction checks, for the stitched surface
+    // and its smoothing (the volume itself is never held).
+    const uint64_t need = st.sticks * (17 + 2 * 12 + bytes_per_stick(options)), cap = options.extract.max_bytes;
+    if (cap && need > cap)
+      throw LimitError(source, "smoothing the stitched surface of " + std::to_string(st.sticks) + " sticks needs about " +
+                                   std::to_string(need >> 20) + " MiB, above the memory limit of " +
+                                   std::to_string(cap >> 20) + " MiB");
     // The whole volume's sticks, exactly: the rest of smooth_surface on them.
     r = smooth_sticks(std::move(surface), options, std::move(r));
     st.levels = r.press.levels;

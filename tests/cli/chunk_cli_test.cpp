@@ -40,6 +40,10 @@ TEST(ChunkCli, StreamedAndWholeFilesWriteTheSameCheckedBytes) {
   ASSERT_EQ(run_cli("-q press " + tmp.path("raw.nrrd") + " --chunk 16 --check -o " + tmp.path("exact.ply"), &out), 0) << out;
   EXPECT_TRUE(test::read_file(tmp.path("whole.ply")) == test::read_file(tmp.path("exact.ply")));
   EXPECT_FALSE(test::read_file(tmp.path("whole.ply")) == a);  // the halo run differs near block borders
+  // A memory cap below what smoothing the stitched surface needs: refused before it, nothing written.
+  EXPECT_EQ(run_cli("-q --max-memory 1M press " + tmp.path("raw.nrrd") + " --chunk 16 -o " + tmp.path("capped.ply"), &out), 1);
+  EXPECT_NE(out.find("memory limit"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp.path("capped.ply")));
   // 1 and 2 threads: the same bytes.
   ASSERT_EQ(run_cli("-q --threads 1 press " + tmp.path("raw.nrrd") + " --chunk 16 --halo 6 -o " + tmp.path("one.ply")), 0);
   EXPECT_TRUE(test::read_file(tmp.path("one.ply")) == a);
