@@ -39,12 +39,7 @@ std::vector<T> from_numpy(const py::dict& piece, const char* key) {
 // The whole volume's lattice from shape, spacing, origin, direction.
 Lattice whole_lattice(const py::handle& shape, const py::object& spacing, const py::object& origin,
                       const py::object& direction) {
-  const Corner dims = corner(shape, "shape");
-  py::array_t<uint8_t> one(std::vector<py::ssize_t>{1, 1, 1});
-  ScalarVolume v = to_volume(one, spacing, origin, direction, "xyz");  // validates spacing, origin, direction
-  v.lattice.dims = dims;
-  v.lattice.validate();
-  return v.lattice;
+  return to_lattice(corner(shape, "shape"), spacing, origin, direction);
 }
 
 py::list py_chunk_plan(const py::handle& shape, int64_t chunk, int64_t halo) {

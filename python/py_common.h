@@ -18,6 +18,10 @@ struct PyMesh {
   py::dict stats;
 };
 
+/// A lattice of `dims` from press()'s spacing, origin and direction
+/// arguments (validated: UsageError naming the bad one).
+Lattice to_lattice(const std::array<int64_t, 3>& dims, const py::object& spacing, const py::object& origin,
+                   const py::object& direction);
 /// The array as a ScalarVolume on its lattice, x fastest whatever its memory
 /// order; axes "xyz": a[i, j, k], "zyx": a[k, j, i].
 ScalarVolume to_volume(const py::array& a, const py::object& spacing, const py::object& origin,

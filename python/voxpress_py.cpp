@@ -61,6 +61,23 @@ Vec3 vec3(const py::object& o, const char* what) {
   return {v[0], v[1], v[2]};
 }
 
+Lattice to_lattice(const std::array<int64_t, 3>& dims, const py::object& spacing, const py::object& origin,
+                   const py::object& direction) {
+  Lattice l;
+  l.dims = dims;
+  l.spacing = vec3(spacing, "spacing");
+  l.origin = vec3(origin, "origin");
+  if (!direction.is_none()) {
+    const auto m = direction.cast<std::vector<std::vector<double>>>();
+    if (m.size() != 3 || m[0].size() != 3 || m[1].size() != 3 || m[2].size() != 3)
+      throw UsageError("direction must be a 3x3 matrix (columns: the physical directions of the array axes)");
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) l.direction(r, c) = m[size_t(r)][size_t(c)];
+  }
+  l.validate();
+  return l;
+}
+
 // The array as a ScalarVolume on its lattice: x fastest, whatever its
 // memory order. axes "xyz": a[i, j, k]; "zyx": a[k, j, i] (SimpleITK).
 ScalarVolume to_volume(const py::array& a, const py::object& spacing, const py::object& origin,
@@ -77,16 +94,7 @@ ScalarVolume to_volume(const py::array& a, const py::object& spacing, const py::
     v.lattice.dims[size_t(d)] = int64_t(a.shape(src));
     stride[size_t(d)] = a.strides(src);
   }
-  v.lattice.spacing = vec3(spacing, "spacing");
-  v.lattice.origin = vec3(origin, "origin");
-  if (!direction.is_none()) {
-    const auto m = direction.cast<std::vector<std::vector<double>>>();
-    if (m.size() != 3 || m[0].size() != 3 || m[1].size() != 3 || m[2].size() != 3)
-      throw UsageError("direction must be a 3x3 matrix (columns: the physical directions of the array axes)");
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) v.lattice.direction(r, c) = m[size_t(r)][size_t(c)];
-  }
-  v.lattice.validate();
+  v.lattice = to_lattice(v.lattice.dims, spacing, origin, direction);
   const size_t item = size_t(a.itemsize());
   v.bytes.resize(size_t(v.lattice.size()) * item);
   const auto* src = static_cast<const std::byte*>(a.data());
