@@ -51,9 +51,10 @@ def main():
 
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="voxpress_ooc_"))
     try:
-        gz, raw = tmp / "part.nrrd", tmp / "part_raw.nrrd"
-        _, s, _ = run(["-q", "generate", "cad-part", "--res", str(args.res), "--rotate", "random:1", "-o", str(gz)])
-        print(f"generated {gz.name} ({args.res}^3, {gz.stat().st_size >> 20} MB gzip) in {s:.0f} s", file=sys.stderr)
+        gz, raw, h5 = tmp / "part.nrrd", tmp / "part_raw.nrrd", tmp / "part.h5"
+        for path in (gz, h5):
+            _, s, _ = run(["-q", "generate", "cad-part", "--res", str(args.res), "--rotate", "random:1", "-o", str(path)])
+            print(f"generated {path.name} ({args.res}^3, {path.stat().st_size >> 20} MB) in {s:.0f} s", file=sys.stderr)
         data, lattice = voxpress.read_volume(str(gz))
         write_raw_nrrd(raw, data, lattice)
         shape = data.shape
@@ -62,6 +63,7 @@ def main():
         c = str(args.chunk)
         runs = [("`--chunk " + c + "`, raw NRRD streamed", raw, ["--chunk", c]),
                 ("`--chunk " + c + " --halo 32`, raw NRRD streamed", raw, ["--chunk", c, "--halo", "32"]),
+                ("`--chunk " + c + "`, HDF5 (64^3 chunks, gzip) streamed", h5, ["--chunk", c]),
                 ("`--chunk " + c + "`, gzip NRRD read whole", gz, ["--chunk", c])]
         if not args.skip_whole:
             runs.insert(0, ("whole volume in memory", raw, []))

@@ -17,6 +17,21 @@
 
 namespace voxpress::test {
 
+/// Runs f, expects an InputError on one line whose message names `path` and
+/// contains `what`.
+template <class F>
+void expect_input_error(F&& f, const std::string& path, const std::string& what) {
+  try {
+    f();
+    ADD_FAILURE() << "no exception for " << path;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+  }
+}
+
 /// A fresh, empty folder removed at the end of the test (its files of up to
 /// 256 KiB are first copied to $VOXPRESS_KEEP_TEST_FILES when that is set:
 /// bench/fuzz's seed corpora).

@@ -42,7 +42,7 @@ void register_generate(CLI::App& app, Global& g) {
   auto c = std::make_shared<GenerateCmd>();
   auto* cmd = app.add_subcommand("generate", "Sample an analytic solid exactly onto a lattice (writes a volume)");
   cmd->add_option("shape", c->shape, "sphere | torus | box | cylinder | cad-part")->required();
-  cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif)")->required();
+  cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif, .h5)")->required();
   c->place.bind(*cmd, "shape");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");
   cmd->callback([c, &g] {

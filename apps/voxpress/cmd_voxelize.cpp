@@ -48,7 +48,7 @@ void register_voxelize(CLI::App& app, Global& g) {
   auto* cmd = app.add_subcommand("voxelize", "Sample a closed mesh exactly onto a lattice (writes a volume that "
                                              "remembers its model and placement, for `voxpress eval`)");
   cmd->add_option("model", c->model, "Closed triangle mesh (.off .obj .stl .ply)")->required();
-  cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif)")->required();
+  cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif, .h5)")->required();
   c->place.bind(*cmd, "model");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");
   cmd->callback([c, &g] {

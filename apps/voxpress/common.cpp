@@ -314,8 +314,8 @@ void check_paths(const std::vector<std::string>& inputs,
         if (!known({".ply", ".obj", ".stl", ".off", ".glb", ".gltf"})) expected = ".ply .obj .stl .off .glb .gltf";
         break;
       case OutputKind::volume:
-        if (!known({".nrrd", ".seg.nrrd", ".nii", ".nii.gz", ".mha", ".tif", ".tiff"}))
-          expected = ".nrrd .nii .nii.gz .mha .tif";
+        if (!known({".nrrd", ".seg.nrrd", ".nii", ".nii.gz", ".mha", ".tif", ".tiff", ".h5", ".hdf5"}))
+          expected = ".nrrd .nii .nii.gz .mha .tif .h5";
         break;
       case OutputKind::json: if (!known({".json"})) expected = ".json"; break;
       case OutputKind::png: if (!known({".png"})) expected = ".png"; break;

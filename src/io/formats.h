@@ -2,7 +2,9 @@
 // volume_io.cpp and mesh_io.cpp.
 #pragma once
 
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "voxpress/core/mesh.h"
@@ -36,6 +38,27 @@ void write_metaimage(const std::string& path, const ScalarVolume& v, bool compre
 ScalarVolume read_tiff(const std::string& path, uint64_t max_bytes);
 ScalarVolume read_tiff_folder(const std::string& path, uint64_t max_bytes);
 void write_tiff(const std::string& path, const ScalarVolume& v);
+
+/// HDF5: "FILE.h5:/dataset" names a dataset, "FILE.h5" means its only 3-D
+/// dataset. split_hdf5_path gives {file, dataset or ""}.
+std::pair<std::string, std::string> split_hdf5_path(const std::string& path);
+bool is_hdf5_path(const std::string& path);
+/// One open 3-D dataset: its header (lattice, type) and boxes read by
+/// hyperslab (x fastest, `out` holds box.size() values). Thread-safe.
+class Hdf5Dataset {
+ public:
+  explicit Hdf5Dataset(const std::string& path);
+  ~Hdf5Dataset();
+  ScalarVolume header;  ///< no bytes
+  void read(const Box& box, std::byte* out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string source_;
+};
+ScalarVolume read_hdf5(const std::string& path, uint64_t max_bytes);
+void write_hdf5(const std::string& path, const ScalarVolume& v, bool compress);
 
 ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t max_bytes, RawPayload* raw = nullptr);
 

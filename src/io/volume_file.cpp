@@ -41,6 +41,7 @@ struct VolumeFile::Impl {
   std::vector<std::unique_ptr<Fd>> fds;  // one per part
   std::vector<uint64_t> starts;          // logical offset of each part
   ScalarVolume whole;                    // when the payload does not stream
+  std::unique_ptr<detail::Hdf5Dataset> h5;
 
   // Logical bytes [offset, offset + size) of the payload.
   void read_bytes(uint64_t offset, uint64_t size, std::byte* out) const {
@@ -70,6 +71,11 @@ VolumeFile::VolumeFile(const std::string& path, const ReadOptions& options) : im
   const std::string ext = detail::extension_of(path);
   std::error_code ec;
   const bool nrrd = ext == ".nrrd" || ext == ".nhdr" || ext == ".seg.nrrd" || ext == ".seg.nhdr";
+  if (!options.raw && detail::is_hdf5_path(path)) {
+    impl_->h5 = std::make_unique<detail::Hdf5Dataset>(path);
+    impl_->header = impl_->h5->header;
+    return;
+  }
   if (options.raw && !std::filesystem::is_directory(path, ec)) {
     impl_->header = detail::read_raw(path, *options.raw, 0, &impl_->raw);
   } else if (nrrd && !std::filesystem::is_directory(path, ec)) {
@@ -95,7 +101,7 @@ VolumeFile::VolumeFile(VolumeFile&&) noexcept = default;
 VolumeFile& VolumeFile::operator=(VolumeFile&&) noexcept = default;
 
 const ScalarVolume& VolumeFile::header() const { return impl_->header; }
-bool VolumeFile::streams() const { return !impl_->raw.parts.empty(); }
+bool VolumeFile::streams() const { return impl_->h5 != nullptr || !impl_->raw.parts.empty(); }
 
 ScalarVolume VolumeFile::read(const Box& box) const {
   const ScalarVolume& h = impl_->header;
@@ -113,6 +119,10 @@ ScalarVolume VolumeFile::read(const Box& box) const {
   const auto d = box.dims();
   const uint64_t row = uint64_t(d[0]) * value;
   v.bytes.resize(box.size() * value);
+  if (impl_->h5) {
+    impl_->h5->read(box, v.bytes.data());
+    return v;
+  }
   const std::byte* src_whole = impl_->whole.bytes.data();
   auto at = [&](int64_t i, int64_t j, int64_t k) { return ((uint64_t(k) * uint64_t(n[1]) + uint64_t(j)) * uint64_t(n[0]) + uint64_t(i)) * value; };
   std::byte* out = v.bytes.data();

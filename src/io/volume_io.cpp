@@ -109,6 +109,7 @@ ScalarVolume read_volume(const std::string& path, const ReadOptions& options) {
   if (options.raw) return detail::read_raw(path, *options.raw, cap);
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return detail::read_tiff_folder(path, cap);
+  if (detail::is_hdf5_path(path)) return detail::read_hdf5(path, cap);
   const std::string ext = detail::extension_of(path);
   if (ext == ".nrrd" || ext == ".nhdr" || ext == ".seg.nrrd" || ext == ".seg.nhdr") return detail::read_nrrd(path, cap);
   if (ext == ".nii" || ext == ".nii.gz" || ext == ".hdr") return detail::read_nifti(path, cap);
@@ -118,7 +119,7 @@ ScalarVolume read_volume(const std::string& path, const ReadOptions& options) {
     throw UsageError(path + ": a raw file needs its layout: --raw-dims X,Y,Z and --raw-type T");
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
   throw InputError(path, "unknown volume format '" + ext +
-                             "' (supported: .nrrd .nhdr .seg.nrrd .nii .nii.gz .mha .mhd .tif .tiff, a folder of "
+                             "' (supported: .nrrd .nhdr .seg.nrrd .nii .nii.gz .mha .mhd .tif .tiff .h5 .hdf5, a folder of "
                              "TIFF slices, .raw with --raw-dims)");
 }
 
@@ -126,11 +127,12 @@ void write_volume(const std::string& path, const ScalarVolume& volume, const Wri
   const std::string ext = detail::extension_of(path);
   if (volume.bytes.size() != volume.value_count() * scalar_size(volume.type))
     throw UsageError("write_volume: data size does not match the lattice");
+  if (detail::is_hdf5_path(path)) return detail::write_hdf5(path, volume, options.compress);
   if (ext == ".nrrd" || ext == ".seg.nrrd") return detail::write_nrrd(path, volume, options.compress);
   if (ext == ".nii" || ext == ".nii.gz") return detail::write_nifti(path, volume);
   if (ext == ".mha") return detail::write_metaimage(path, volume, options.compress);
   if (ext == ".tif" || ext == ".tiff") return detail::write_tiff(path, volume);
-  throw UsageError(path + ": cannot write volume format '" + ext + "' (use .nrrd, .nii, .nii.gz, .mha or .tif)");
+  throw UsageError(path + ": cannot write volume format '" + ext + "' (use .nrrd, .nii, .nii.gz, .mha, .tif or .h5)");
 }
 
 }  // namespace voxpress

@@ -1,5 +1,6 @@
-// press --chunk from the command line: a raw NRRD streamed block by block
-// and the same samples gzip-compressed (read whole) write the same bytes,
+// press --chunk from the command line: a raw NRRD or an HDF5 dataset
+// streamed block by block and the same samples gzip-compressed (read whole)
+// write the same bytes,
 // without a halo the bytes of `press` itself, pass --check, resolve an
 // automatic selection over the whole file, and bad options leave no output.
 #include <nlohmann/json.hpp>
@@ -39,6 +40,15 @@ TEST(ChunkCli, StreamedAndWholeFilesWriteTheSameCheckedBytes) {
   ASSERT_EQ(run_cli("-q press " + tmp.path("gz.nrrd") + " -o " + tmp.path("whole.ply"), &out), 0) << out;
   ASSERT_EQ(run_cli("-q press " + tmp.path("raw.nrrd") + " --chunk 16 --check -o " + tmp.path("exact.ply"), &out), 0) << out;
   EXPECT_TRUE(test::read_file(tmp.path("whole.ply")) == test::read_file(tmp.path("exact.ply")));
+  // HDF5 (chunked, gzip) streams by hyperslab: the same bytes again.
+  ASSERT_EQ(run_cli("-q generate cad-part --res 48 --rotate random:2 --spacing 1,1,1.5 -o " + tmp.path("v.h5"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q press " + tmp.path("v.h5") + ":/volume --chunk 16 --check --stats-json " + tmp.path("h5.json") +
+                        " -o " + tmp.path("h5.ply"),
+                    &out),
+            0)
+      << out;
+  EXPECT_TRUE(read_json(tmp.path("h5.json"))["chunks"]["streamed"].get<bool>());
+  EXPECT_TRUE(test::read_file(tmp.path("whole.ply")) == test::read_file(tmp.path("h5.ply")));
   EXPECT_FALSE(test::read_file(tmp.path("whole.ply")) == a);  // the halo run differs near block borders
   // A memory cap below what smoothing the stitched surface needs: refused before it, nothing written.
   EXPECT_EQ(run_cli("-q --max-memory 1M press " + tmp.path("raw.nrrd") + " --chunk 16 -o " + tmp.path("capped.ply"), &out), 1);

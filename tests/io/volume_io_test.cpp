@@ -37,19 +37,7 @@ void expect_same_lattice(const Lattice& a, const Lattice& b, double tol = 1e-9) 
   EXPECT_LT((a.direction - b.direction).norm(), tol);
 }
 
-// Runs f, expects an InputError whose message names `path` and contains `what`.
-template <class F>
-void expect_input_error(F&& f, const std::string& path, const std::string& what) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception for " << path;
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(path), std::string::npos) << msg;
-    EXPECT_NE(msg.find(what), std::string::npos) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
-  }
-}
+using test::expect_input_error;
 
 TEST(VolumeIO, RoundTripEveryWriterAndType) {
   test::TempDir tmp;

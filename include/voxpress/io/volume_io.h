@@ -7,6 +7,8 @@
 //   .nii .nii.gz .hdr      NIfTI-1 and NIfTI-2 (nifti_clib); sform, else qform
 //   .mha .mhd              MetaImage: LOCAL or separate data file, zlib compression
 //   .tif .tiff             multi-page 3D TIFF (one page per slice, ImageJ spacing)
+//   .h5 .hdf5              HDF5: FILE.h5:/dataset, or the file's only 3-D
+//                          dataset; spacing from element_size_um (z, y, x)
 //   a folder               2D TIFF slices, sorted by the numbers in their names
 //   .raw .bin              raw samples, layout given by RawLayout
 // Voxel types: 8/16/32/64-bit signed and unsigned integers, 32/64-bit float.
@@ -63,7 +65,7 @@ struct WriteVolumeOptions {
   bool compress = true;  ///< gzip for NRRD and .nii.gz is implied by the name; zlib for .mha
 };
 
-/// Writes a volume (NRRD, NIfTI, MetaImage or multi-page TIFF by extension),
+/// Writes a volume (NRRD, NIfTI, MetaImage, multi-page TIFF or HDF5 by extension),
 /// atomically: a failed write leaves no file behind.
 void write_volume(const std::string& path, const ScalarVolume& volume, const WriteVolumeOptions& options = {});
 
