@@ -1,6 +1,7 @@
 // The chunked core for Python: chunk_plan (the blocks and the boxes to read),
 // _press_block (one block's piece: numpy arrays of global stick keys, so a
-// piece pickles compactly for Dask), _stitch (pieces -> Mesh), and the
+// piece pickles compactly for Dask), _merge (consecutive pieces -> one:
+// the tree reduction's step), _stitch (pieces -> Mesh), and the
 // in-process press(..., chunk=) path. voxpress/dask.py maps _press_block
 // over a Dask array's blocks; the results are the CLI's `press --chunk`.
 #include <pybind11/stl.h>
@@ -34,6 +35,37 @@ std::vector<T> from_numpy(const py::dict& piece, const char* key) {
   const auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(piece[key]);
   if (!a) throw UsageError(std::string("a piece's '") + key + "' is not an array");
   return std::vector<T>(a.data(), a.data() + a.size());
+}
+
+// A piece as Dask moves it: numpy arrays (pickled compactly) and counts.
+py::dict to_dict(const SurfacePiece& piece) {
+  py::dict d;
+  d["block"] = piece.block;
+  d["count"] = piece.count;
+  d["blocks"] = piece.blocks;
+  d["sticks"] = to_numpy(piece.sticks);
+  d["code"] = to_numpy(piece.code);
+  d["t"] = to_numpy(piece.t);
+  d["triangles"] = to_numpy(piece.triangles);
+  d["iterations"] = piece.press.iterations;
+  return d;
+}
+
+SurfacePiece from_dict(const py::dict& d) {
+  for (const char* key : {"block", "count", "blocks"})
+    if (!d.contains(key)) throw UsageError(std::string("a piece lacks '") + key + "' (not from _press_block?)");
+  SurfacePiece p;
+  p.block = d["block"].cast<uint64_t>();
+  p.count = d["count"].cast<uint64_t>();
+  p.blocks = d["blocks"].cast<uint64_t>();
+  p.sticks = from_numpy<uint64_t>(d, "sticks");
+  p.code = from_numpy<uint8_t>(d, "code");
+  p.t = from_numpy<double>(d, "t");
+  p.triangles = from_numpy<uint64_t>(d, "triangles");
+  if (d.contains("iterations")) p.press.iterations = d["iterations"].cast<int>();
+  if (p.code.size() != p.sticks.size() || p.t.size() != p.sticks.size() || p.triangles.size() % 3)
+    throw UsageError("a piece's arrays do not match (sticks, code, t, triangles)");
+  return p;
 }
 
 // The whole volume's lattice from shape, spacing, origin, direction.
@@ -88,15 +120,18 @@ py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t b
       piece = press_block(b, grid, block, pressed);
     }
   }
-  py::dict d;
-  d["block"] = piece.block;
-  d["blocks"] = piece.blocks;
-  d["sticks"] = to_numpy(piece.sticks);
-  d["code"] = to_numpy(piece.code);
-  d["t"] = to_numpy(piece.t);
-  d["triangles"] = to_numpy(piece.triangles);
-  d["iterations"] = piece.press.iterations;
-  return d;
+  return to_dict(piece);
+}
+
+py::dict py_merge(const py::list& pieces, const py::handle& shape) {
+  std::vector<SurfacePiece> ps;
+  for (const py::handle& h : pieces) ps.push_back(from_dict(h.cast<py::dict>()));
+  SurfacePiece out;
+  {
+    py::gil_scoped_release release;
+    out = merge_pieces(ps, corner(shape, "shape"));
+  }
+  return to_dict(out);
 }
 
 PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::object& spacing, const py::object& origin,
@@ -106,18 +141,9 @@ PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::obje
   const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
   std::vector<SurfacePiece> ps;
   for (const py::handle& h : pieces) {
-    const py::dict d = h.cast<py::dict>();
-    SurfacePiece p;
-    p.block = d["block"].cast<uint64_t>();
-    p.blocks = d["blocks"].cast<uint64_t>();
-    p.sticks = from_numpy<uint64_t>(d, "sticks");
-    p.code = from_numpy<uint8_t>(d, "code");
-    p.t = from_numpy<double>(d, "t");
-    p.triangles = from_numpy<uint64_t>(d, "triangles");
-    if (p.code.size() != p.sticks.size() || p.t.size() != p.sticks.size() || p.triangles.size() % 3)
-      throw UsageError("a piece's arrays do not match (sticks, code, t, triangles)");
-    ps.push_back(std::move(p));
+    ps.push_back(from_dict(h.cast<py::dict>()));
   }
+  const uint64_t blocks = ps.empty() ? 0 : ps[0].blocks;
   PyMesh out;
   int iterations = 0;
   size_t flats = 0;
@@ -140,7 +166,7 @@ PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::obje
     out.stats["flats"] = flats;
   }
   out.stats["method"] = "pressing";
-  out.stats["blocks"] = py::len(pieces);
+  out.stats["blocks"] = blocks;
   out.stats["vertices"] = out.mesh.vertex_count();
   out.stats["triangles"] = out.mesh.face_count();
   return out;
@@ -180,6 +206,9 @@ void bind_chunks(py::module_& m) {
         py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
         py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
         "One block's piece (voxpress.dask): mask is the block's read box, non-zero inside; threads 0: all cores.");
+  m.def("_merge", &py_merge, py::arg("pieces"), py::kw_only(), py::arg("shape"),
+        "One piece of consecutive ones (each one's blocks follow the one before): a step of voxpress.dask's tree "
+        "reduction.");
   m.def("_stitch", &py_stitch, py::arg("pieces"), py::kw_only(), py::arg("shape"),
         py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
         py::arg("direction") = py::none(), py::arg("smooth") = false,

@@ -11,10 +11,13 @@ The volume is cut into blocks of `chunk` samples per side (voxpress.chunk_plan).
 Each block, read with `halo` more samples on every side, is one Dask task
 (voxpress._press_block, run on a worker) returning its piece of the surface:
 numpy arrays of global stick keys, codes, pressed positions and triangles,
-which pickle compactly. The pieces are stitched by key on the caller into
-one mesh with exactly the sticks, triangles and order of the whole-volume
-run; the result is byte for byte `voxpress press --chunk` on the same
-samples. Flats are off, as with --chunk. Dask does the scheduling, transfer
+which pickle compactly. Consecutive pieces merge on the workers, up to
+split_every at a time (a tree reduction, voxpress._merge), and the caller
+turns the few pieces left
+into one mesh with exactly the sticks, triangles and order of the
+whole-volume run: byte for byte `voxpress press --chunk` on the same
+samples (exact mode: the caller smooths it, flats and sharp edges
+included). Dask does the scheduling, transfer
 and retries; nothing here is a scheduler.
 """
 import numpy as np
@@ -39,8 +42,12 @@ def _block(mask, **kw):
     return _voxpress._press_block(np.asarray(mask), **kw)
 
 
+def _merge(*pieces, **kw):  # a module function pickles by name; the binding itself does not
+    return _voxpress._merge(list(pieces), **kw)
+
+
 def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
-          label=None, threshold=None, client=None, threads=0, **options):
+          label=None, threshold=None, client=None, threads=0, split_every=16, **options):
     """The smooth surface of a Dask, Zarr or numpy array, block by block on Dask; returns a Mesh.
 
     array: indexed array[i, j, k] (x first); a zarr array is wrapped with
@@ -56,7 +63,9 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
     (docs/BENCHMARKS.md, Chunked). client: a dask.distributed Client; None
     uses Dask's current scheduler (a Client you created, else threads).
     threads: cores one block task uses (0: all its machine's; set it to the
-    worker's threads when several workers share a machine).
+    worker's threads when several workers share a machine). split_every:
+    the tree reduction's fan-in (pieces merged per task, and at most what
+    the caller receives).
     """
     import dask
     import dask.array as da
@@ -66,6 +75,9 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
             array = da.from_zarr(array)
         else:
             array = da.from_array(np.asarray(array), chunks=chunk)
+    if int(split_every) < 2:
+        raise _voxpress.UsageError(f"split_every must be at least 2 (got {split_every})")
+    split_every = int(split_every)
     if array.ndim != 3:
         raise _voxpress.UsageError(f"the array must be 3-D (got {array.ndim} dimensions)")
     shape = tuple(int(n) for n in array.shape)
@@ -90,9 +102,15 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
         tasks.append(block(inside[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, halo=halo,
                            bounds=(lo, hi), spacing=spacing, origin=origin, direction=direction, threads=threads,
                            **(options if halo else {})))
+    # Tree reduction: up to split_every consecutive pieces merge on a worker
+    # (a k-way merge in whole-run order), level after level, until the
+    # caller has at most split_every of them to stitch.
+    merge = dask.delayed(_merge, pure=True)
+    while len(tasks) > split_every:
+        tasks = [merge(*tasks[i:i + split_every], shape=shape) for i in range(0, len(tasks), split_every)]
     if client is not None:
         pieces = client.gather(client.compute(tasks))
     else:
-        pieces = dask.compute(*tasks)
-    return _voxpress._stitch(list(pieces), shape=shape, spacing=spacing, origin=origin, direction=direction,
+        pieces = list(dask.compute(*tasks))
+    return _voxpress._stitch(pieces, shape=shape, spacing=spacing, origin=origin, direction=direction,
                              smooth=not halo, **(options if not halo else {}))

@@ -7,6 +7,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <queue>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -186,6 +187,75 @@ SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_
   return out;
 }
 
+namespace {
+
+// A triangle's cube (padded linear index of its lower corner): the
+// componentwise minimum of its sticks' lower samples, the order key of the
+// whole run's triangles.
+uint64_t cube_of(const KeyCodec& codec, const uint64_t* tri) {
+  uint64_t c[3] = {UINT64_MAX, UINT64_MAX, UINT64_MAX};
+  for (int v = 0; v < 3; ++v) {
+    const auto d = codec.decode(tri[v]);
+    for (int a = 0; a < 3; ++a) c[a] = std::min(c[a], d[size_t(a)]);
+  }
+  return c[0] + codec.px * (c[1] + codec.py * c[2]);
+}
+
+}  // namespace
+
+SurfacePiece merge_pieces(const std::vector<SurfacePiece>& pieces, const std::array<int64_t, 3>& dims) {
+  if (pieces.empty()) throw UsageError("merge_pieces: no piece");
+  for (size_t i = 1; i < pieces.size(); ++i)
+    if (pieces[i].blocks != pieces[0].blocks || pieces[i].block != pieces[i - 1].block + pieces[i - 1].count)
+      throw UsageError("merge_pieces: the pieces are not consecutive blocks of one grid");
+  if (pieces.back().block + pieces.back().count > pieces[0].blocks)
+    throw UsageError("merge_pieces: the pieces are not consecutive blocks of one grid");
+  const KeyCodec codec(dims);
+  SurfacePiece out;
+  out.block = pieces[0].block;
+  out.blocks = pieces[0].blocks;
+  out.count = 0;
+  size_t n = 0, m = 0;
+  for (const SurfacePiece& p : pieces) {
+    out.count += p.count;
+    n += p.sticks.size();
+    m += p.triangles.size();
+    if (p.press.iterations > out.press.iterations) out.press = p.press;
+  }
+  // k-way merges by key (sticks) and by cube (triangles: a cube's triangles
+  // all come from one block, so each piece's order within a cube is kept).
+  using Head = std::pair<uint64_t, size_t>;  // (key, piece)
+  std::priority_queue<Head, std::vector<Head>, std::greater<>> heap;
+  std::vector<size_t> at(pieces.size(), 0);
+  out.sticks.reserve(n);
+  out.code.reserve(n);
+  out.t.reserve(n);
+  for (size_t p = 0; p < pieces.size(); ++p)
+    if (!pieces[p].sticks.empty()) heap.push({pieces[p].sticks[0], p});
+  while (!heap.empty()) {
+    const auto [key, p] = heap.top();
+    heap.pop();
+    const size_t i = at[p]++;
+    out.sticks.push_back(key);
+    out.code.push_back(pieces[p].code[i]);
+    out.t.push_back(pieces[p].t[i]);
+    if (at[p] < pieces[p].sticks.size()) heap.push({pieces[p].sticks[at[p]], p});
+  }
+  out.triangles.reserve(m);
+  std::fill(at.begin(), at.end(), 0);
+  for (size_t p = 0; p < pieces.size(); ++p)
+    if (!pieces[p].triangles.empty()) heap.push({cube_of(codec, pieces[p].triangles.data()), p});
+  while (!heap.empty()) {
+    const size_t p = heap.top().second;
+    heap.pop();
+    const uint64_t* t = pieces[p].triangles.data() + at[p];
+    out.triangles.insert(out.triangles.end(), t, t + 3);
+    at[p] += 3;
+    if (at[p] < pieces[p].triangles.size()) heap.push({cube_of(codec, pieces[p].triangles.data() + at[p]), p});
+  }
+  return out;
+}
+
 StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pieces) {
   const auto& dims = lattice.dims;
   const KeyCodec codec(dims);
@@ -194,12 +264,16 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
   out.padded = {dims[0] + 2, dims[1] + 2, dims[2] + 2};
 
   std::vector<uint8_t> seen(pieces.empty() ? 0 : pieces[0].blocks, 0);
+  size_t covered = 0;
   for (const SurfacePiece& p : pieces) {
-    if (p.blocks != seen.size() || p.block >= seen.size() || seen[p.block]++)
+    if (p.blocks != seen.size() || p.count < 1 || p.block >= seen.size() || p.count > seen.size() - p.block)
       throw UsageError("stitch: the pieces are not each block of one grid exactly once");
+    for (uint64_t b = p.block; b < p.block + p.count; ++b)
+      if (seen[b]++) throw UsageError("stitch: the pieces are not each block of one grid exactly once");
+    covered += p.count;
   }
-  if (pieces.size() != seen.size()) throw UsageError("stitch: " + std::to_string(seen.size() - pieces.size()) +
-                                                     " of the grid's " + std::to_string(seen.size()) + " blocks are missing");
+  if (covered != seen.size()) throw UsageError("stitch: " + std::to_string(seen.size() - covered) + " of the grid's " +
+                                               std::to_string(seen.size()) + " blocks are missing");
 
   // Sticks: (key, piece, index) sorted by key; keys are unique.
   size_t n = 0, m = 0;
@@ -249,14 +323,7 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
       for (size_t i = 0; i + 2 < p.triangles.size(); i += 3, ++w) first[w] = p.triangles.data() + i;
   }
   tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      uint64_t c[3] = {UINT64_MAX, UINT64_MAX, UINT64_MAX};
-      for (int v = 0; v < 3; ++v) {
-        const auto d = codec.decode(first[i][v]);
-        for (int a = 0; a < 3; ++a) c[a] = std::min(c[a], d[size_t(a)]);
-      }
-      order[i] = {c[0] + codec.px * (c[1] + codec.py * c[2]), i};
-    }
+    for (size_t i = r.begin(); i < r.end(); ++i) order[i] = {cube_of(codec, first[i]), i};
   });
   tbb::parallel_sort(order.begin(), order.end());
   out.triangles.resize(m);

@@ -178,6 +178,22 @@ TEST(Chunked, SameBytesForAnyThreadCountAndPieceOrder) {
   const Mesh reversed = to_mesh(stitch(s.volume.lattice, pieces));
   EXPECT_EQ(reversed.positions, many.positions);
   EXPECT_EQ(reversed.triangles, many.triangles);
+  // A tree of merges of consecutive pieces (voxpress.dask's reduction, here
+  // 3 at a time) leaves one piece, the same surface.
+  std::vector<SurfacePiece> level(pieces.rbegin(), pieces.rend());
+  while (level.size() > 1) {
+    std::vector<SurfacePiece> next;
+    for (size_t i = 0; i < level.size(); i += 3)
+      next.push_back(merge_pieces({level.begin() + long(i), level.begin() + long(std::min(i + 3, level.size()))},
+                                  s.volume.lattice.dims));
+    level = std::move(next);
+  }
+  ASSERT_EQ(level[0].count, grid.count());
+  const Mesh merged = to_mesh(stitch(s.volume.lattice, level));
+  EXPECT_EQ(merged.positions, many.positions);
+  EXPECT_EQ(merged.triangles, many.triangles);
+  EXPECT_THROW(merge_pieces({pieces[0], pieces[1]}, s.volume.lattice.dims), UsageError);  // not consecutive
+  EXPECT_THROW(stitch(s.volume.lattice, {level[0], pieces[0]}), UsageError);          // a block twice
   // A missing or doubled piece would be a hole or an overlap: refused.
   pieces.push_back(pieces.front());
   EXPECT_THROW(stitch(s.volume.lattice, pieces), UsageError);

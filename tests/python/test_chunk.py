@@ -75,7 +75,8 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         array = da.from_array(mask.astype(np.uint8), chunks=96)  # Dask's chunks need not be the blocks
-        mesh = voxpress.dask.press(array, chunk=128, spacing=spacing, origin=origin, client=client)
+        # split_every=3: the 8 pieces merge on the workers (3 + 3 + 2), then the caller stitches 3.
+        mesh = voxpress.dask.press(array, chunk=128, spacing=spacing, origin=origin, client=client, split_every=3)
     np.testing.assert_array_equal(mesh.faces, ref.faces)
     np.testing.assert_array_equal(mesh.vertices, ref.vertices)
     assert mesh.stats["blocks"] == 8
@@ -83,9 +84,11 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
     # Blocks pressed on the workers (a halo), the threaded scheduler, a label:
     # the in-process run with the same halo.
     labels = np.where(mask, 3, 0).astype(np.int16)[100:164, 100:164, 20:84]
-    again = voxpress.dask.press(da.from_array(labels, chunks=32), chunk=32, halo=8, label=3)
+    again = voxpress.dask.press(da.from_array(labels, chunks=32), chunk=32, halo=8, label=3, split_every=2)
     small = voxpress.press(labels == 3, chunk=32, halo=8)
     np.testing.assert_array_equal(again.vertices, small.vertices)
     np.testing.assert_array_equal(again.faces, small.faces)
     with pytest.raises(voxpress.InputError):
         voxpress.dask.press(da.zeros((32, 32, 32), chunks=16), chunk=16)
+    with pytest.raises(voxpress.UsageError):
+        voxpress.dask.press(labels, chunk=32, split_every=1)

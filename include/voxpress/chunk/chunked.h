@@ -85,6 +85,7 @@ struct SurfacePiece {
   std::vector<uint64_t> triangles;  ///< owned triangles: 3 stick keys each, in whole-run order
   PressStats press;                 ///< the block's Pressing (iterations == 0: nothing to press)
   uint64_t block = 0, blocks = 0;   ///< which block of how many (stitch wants each exactly once)
+  uint64_t count = 1;               ///< merged pieces: the blocks [block, block + count)
 };
 
 /// Global key of a stick: its lower sample (p, q, r) in padded index space
@@ -98,6 +99,12 @@ uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t,
 /// midpoint t (the exact mode's extraction).
 SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b,
                          const SurfaceOptions* options);
+
+/// One piece of consecutive pieces (each piece's blocks follow the one
+/// before): sticks and triangles merged in whole-run order (k-way), so a
+/// tree of merges (voxpress.dask) leaves stitch sorted pieces. UsageError if
+/// the blocks are not consecutive blocks of one grid.
+SurfacePiece merge_pieces(const std::vector<SurfacePiece>& pieces, const std::array<int64_t, 3>& dims);
 
 /// Joins the blocks' pieces into the whole volume's stick surface (any piece
 /// order; deterministic). Throws UsageError unless the pieces are each block
