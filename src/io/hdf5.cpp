@@ -226,8 +226,10 @@ ScalarVolume read_hdf5(const std::string& path, uint64_t max_bytes) {
 
 void write_hdf5(const std::string& path, const ScalarVolume& v, bool compress) {
   if (v.components != 1) throw UsageError(path + ": HDF5 output holds one value per sample");
-  const auto [file, name] = split_hdf5_path(path);
-  write_atomically(file, [&, name = name](const std::string& tmp) {
+  const auto parts = split_hdf5_path(path);
+  const std::string& file = parts.first;
+  const std::string& name = parts.second;
+  write_atomically(file, [&](const std::string& tmp) {
     std::lock_guard lock(hdf5_lock());
     h5_quiet();
     Handle f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);

@@ -1,0 +1,47 @@
+// voxpress/labels/shared_surface.h — one surface for every label of a label
+// map, each interface shared by the two labels it separates (issue 54).
+//
+// Vertices: one per stick (a lattice edge whose two samples have different
+// labels; samples beyond the lattice are background 0), one at the centre
+// of each face where three or four labels meet around a point, and the
+// apexes of the label cases that need one (label_cases.h). Every triangle
+// separates two labels and is stored once, wound counter-clockwise seen
+// from its `out` label (its normal points from `in` to `out`); each label's
+// closed surface is its triangles, those of which it is `out` reversed. A
+// label against the background alone gives exactly the binary midpoint
+// surface (extract_sticks, t = 0.5). This is the midpoint surface: every
+// vertex at its stick's midpoint, its face's or its case's centre; the
+// smoothing of shared surfaces (Pressing with junction curves) is not done
+// yet.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "voxpress/core/mesh.h"
+#include "voxpress/core/volume.h"
+
+namespace voxpress {
+
+struct SharedSurface {
+  Lattice lattice;
+  std::vector<uint32_t> labels;  ///< label values by index; index 0 is the background, 0
+  Mesh mesh;                     ///< physical positions; every interface triangle once
+  std::vector<std::array<uint32_t, 2>> sides;  ///< per triangle: (in, out) label indices
+  uint64_t stick_vertices = 0, face_vertices = 0, apex_vertices = 0;
+};
+
+/// The shared midpoint surface of a label map (integer values 0..2^32-1,
+/// one component). Deterministic for any thread count. Throws InputError
+/// (naming volume.source) for fractional or negative values, a volume with
+/// a single value, or a cube whose labelling has no derived case yet (some
+/// cubes of four or more labels; the error names the cube).
+SharedSurface extract_shared_surface(const ScalarVolume& volume);
+
+/// The closed, outward surface of label index `label` (its triangles, the
+/// ones it is `out` of reversed), vertices renumbered in order of the
+/// shared mesh. Vertex positions are bit-identical to the shared mesh's.
+Mesh label_mesh(const SharedSurface& surface, uint32_t label);
+
+}  // namespace voxpress

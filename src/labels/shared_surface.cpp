@@ -1,0 +1,220 @@
+// The shared midpoint surface of a label map: every cube's label case
+// (label_cases.h), vertices named by global keys so that neighbouring cubes
+// meet on the same stick and face vertices, then one sort of the keys.
+#include "voxpress/labels/shared_surface.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "voxpress/core/error.h"
+#include "voxpress/extract/cube_cases.h"
+#include "voxpress/labels/label_cases.h"
+
+namespace voxpress {
+namespace {
+
+// Vertex kinds per padded sample: sticks along x, y, z; face centres normal
+// to x, y, z; the apexes of its cube.
+constexpr uint64_t kKinds = 6 + uint64_t(kMaxApexes);
+
+struct Keys {
+  uint64_t px, py;
+  uint64_t key(const std::array<int64_t, 3>& p, uint64_t kind) const {
+    return ((uint64_t(p[2]) * py + uint64_t(p[1])) * kKinds + kind) * px + uint64_t(p[0]);
+  }
+  // padded sample and kind of a key
+  std::pair<std::array<int64_t, 3>, uint64_t> decode(uint64_t key) const {
+    const uint64_t p = key % px, rest = key / px, kind = rest % kKinds, row = rest / kKinds;
+    return {{int64_t(p), int64_t(row % py), int64_t(row / py)}, kind};
+  }
+};
+
+struct Emitted {
+  std::array<uint64_t, 3> keys;
+  uint32_t in, out;
+};
+
+}  // namespace
+
+SharedSurface extract_shared_surface(const ScalarVolume& volume) {
+  if (volume.components != 1) throw InputError(volume.source, "a label map has one value per sample");
+  volume.lattice.validate();
+  const auto& n = volume.lattice.dims;
+  // Sample labels, validated, and the label values present.
+  std::vector<uint32_t> lab(volume.lattice.size());
+  std::atomic<bool> bad{false};
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, lab.size(), 1 << 16), [&](const tbb::blocked_range<uint64_t>& r) {
+    for (uint64_t i = r.begin(); i < r.end(); ++i) {
+      const double x = volume.value(i);
+      if (!(x >= 0 && x <= 4294967295.0 && x == std::floor(x))) bad = true;
+      else lab[i] = uint32_t(x);
+    }
+  });
+  if (bad) throw InputError(volume.source, "a label map holds whole numbers from 0 to 2^32 - 1 (found another value)");
+  SharedSurface out;
+  out.lattice = volume.lattice;
+  {
+    std::vector<uint32_t> values = lab;
+    tbb::parallel_sort(values.begin(), values.end());
+    values.erase(std::unique(values.begin(), values.end()), values.end());
+    if (values.size() < 2 && (values.empty() || values[0] == 0))
+      throw InputError(volume.source, "the volume is empty: every sample is the background, 0");
+    if (values[0] != 0) values.insert(values.begin(), 0u);  // beyond the lattice is background
+    out.labels = std::move(values);
+  }
+  auto index_of = [&](uint32_t value) {
+    return uint32_t(std::lower_bound(out.labels.begin(), out.labels.end(), value) - out.labels.begin());
+  };
+  auto at = [&](int64_t i, int64_t j, int64_t k) -> uint32_t {  // unpadded; background beyond
+    if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) return 0;
+    return lab[volume.lattice.linear(i, j, k)];
+  };
+  const Keys keys{uint64_t(n[0] + 2), uint64_t(n[1] + 2)};
+
+  // Cubes by padded lower corner (p, q, r) in [0, n]: one layer per r.
+  std::vector<std::vector<Emitted>> layers(size_t(n[2] + 1));
+  std::mutex apex_mutex;
+  std::vector<std::pair<uint64_t, Vec3>> apex_positions;
+  std::string underivable;
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, n[2] + 1, 1), [&](const tbb::blocked_range<int64_t>& rr) {
+    std::vector<std::pair<uint64_t, Vec3>> apexes;
+    for (int64_t r = rr.begin(); r < rr.end(); ++r) {
+      auto& emitted = layers[size_t(r)];
+      for (int64_t q = 0; q <= n[1]; ++q)
+        for (int64_t p = 0; p <= n[0]; ++p) {
+          std::array<uint32_t, 8> c;
+          bool same = true;
+          for (int k = 0; k < 8; ++k) {
+            c[size_t(k)] = at(p - 1 + (k & 1), q - 1 + ((k >> 1) & 1), r - 1 + ((k >> 2) & 1));
+            same = same && c[size_t(k)] == c[0];
+          }
+          if (same) continue;
+          int distinct = 0;
+          const LabelPattern pattern = label_pattern(c, &distinct);
+          const LabelCase* lc = nullptr;
+          try {
+            lc = &label_case(pattern);
+          } catch (const std::logic_error&) {
+            std::lock_guard lock(apex_mutex);
+            if (underivable.empty())
+              underivable = "the cube at sample (" + std::to_string(p - 1) + ", " + std::to_string(q - 1) + ", " +
+                            std::to_string(r - 1) + ") joins " + std::to_string(distinct) +
+                            " labels in a way shared surfaces do not handle yet (issue 54)";
+            continue;
+          }
+          std::array<uint32_t, 8> sorted = c;  // rank -> value: the first `distinct` after unique
+          std::sort(sorted.begin(), sorted.end());
+          std::unique(sorted.begin(), sorted.end());
+          const std::array<int64_t, 3> cube{p, q, r};
+          auto vertex_key = [&](int v) {
+            if (v < 12) {
+              const int a = cube_edge_axis(v), c0 = cube_edge_corner(v, 0);
+              return keys.key({p + (c0 & 1), q + ((c0 >> 1) & 1), r + ((c0 >> 2) & 1)}, uint64_t(a));
+            }
+            if (v < kApex) {
+              const int f = v - kFaceCenter, a = f / 2, side = f % 2;
+              std::array<int64_t, 3> lo = cube;
+              lo[size_t(a)] += side;
+              return keys.key(lo, uint64_t(3 + a));
+            }
+            return keys.key(cube, uint64_t(6 + (v - kApex)));
+          };
+          for (size_t k = 0; k < lc->apexes.size(); ++k)
+            apexes.push_back({keys.key(cube, 6 + k), Vec3(double(p - 1), double(q - 1), double(r - 1)) + lc->apexes[k]});
+          for (const auto& t : lc->triangles)
+            emitted.push_back({{vertex_key(t.v[0]), vertex_key(t.v[1]), vertex_key(t.v[2])},
+                               index_of(sorted[t.in]), index_of(sorted[t.out])});
+        }
+    }
+    std::lock_guard lock(apex_mutex);
+    apex_positions.insert(apex_positions.end(), apexes.begin(), apexes.end());
+  });
+  if (!underivable.empty()) throw InputError(volume.source, underivable);
+
+  // Vertices: the keys in increasing order.
+  size_t m = 0;
+  for (const auto& l : layers) m += l.size();
+  std::vector<uint64_t> all;
+  all.reserve(3 * m);
+  for (const auto& l : layers)
+    for (const Emitted& e : l) all.insert(all.end(), e.keys.begin(), e.keys.end());
+  tbb::parallel_sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  if (all.size() >= UINT32_MAX) throw LimitError(volume.source, "more than 2^32 - 1 vertices");
+  tbb::parallel_sort(apex_positions.begin(), apex_positions.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+  const Mat3 M = volume.lattice.index_to_physical_matrix();
+  out.mesh.positions.resize(all.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const auto [s, kind] = keys.decode(all[i]);
+      Vec3 x(double(s[0] - 1), double(s[1] - 1), double(s[2] - 1));
+      if (kind < 3) {
+        x[int(kind)] += 0.5;
+      } else if (kind < 6) {
+        for (int a = 0; a < 3; ++a)
+          if (a != int(kind - 3)) x[a] += 0.5;
+      } else {
+        const auto it = std::lower_bound(apex_positions.begin(), apex_positions.end(), all[i],
+                                         [](const auto& e, uint64_t k) { return e.first < k; });
+        x = it->second;
+      }
+      out.mesh.positions[i] = volume.lattice.origin + M * x;
+    }
+  });
+  for (uint64_t key : all) {
+    const uint64_t kind = keys.decode(key).second;
+    (kind < 3 ? out.stick_vertices : kind < 6 ? out.face_vertices : out.apex_vertices)++;
+  }
+  // Triangles in cube order, the keys looked up.
+  out.mesh.triangles.resize(m);
+  out.sides.resize(m);
+  const bool flip = volume.lattice.flips_orientation();
+  size_t base = 0;
+  for (const auto& l : layers) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, l.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        Triangle t;
+        for (int v = 0; v < 3; ++v)
+          t[size_t(v)] = uint32_t(std::lower_bound(all.begin(), all.end(), l[i].keys[size_t(v)]) - all.begin());
+        if (flip) std::swap(t[1], t[2]);
+        out.mesh.triangles[base + i] = t;
+        out.sides[base + i] = {l[i].in, l[i].out};
+      }
+    });
+    base += l.size();
+  }
+  return out;
+}
+
+Mesh label_mesh(const SharedSurface& s, uint32_t label) {
+  Mesh m;
+  std::vector<uint32_t> id(s.mesh.positions.size(), UINT32_MAX);
+  std::vector<uint8_t> used(s.mesh.positions.size(), 0);
+  for (size_t f = 0; f < s.sides.size(); ++f)
+    if (s.sides[f][0] == label || s.sides[f][1] == label)
+      for (uint32_t v : s.mesh.triangles[f]) used[v] = 1;
+  for (size_t v = 0; v < used.size(); ++v)
+    if (used[v]) {
+      id[v] = uint32_t(m.positions.size());
+      m.positions.push_back(s.mesh.positions[v]);
+    }
+  for (size_t f = 0; f < s.sides.size(); ++f) {
+    if (s.sides[f][0] != label && s.sides[f][1] != label) continue;
+    const Triangle& t = s.mesh.triangles[f];
+    Triangle u{id[t[0]], id[t[1]], id[t[2]]};
+    if (s.sides[f][1] == label) std::swap(u[1], u[2]);  // it is this triangle's out side: outward is the other way
+    m.triangles.push_back(u);
+  }
+  return m;
+}
+
+}  // namespace voxpress
