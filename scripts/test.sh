@@ -59,9 +59,10 @@ Truth.SharpEdges:Shapes.SampledVolumeMatchesAnalyticVolume:Flats.JunctionAngleOp
 Sharpen.CurvedCreasesOnlyWhereTheyContinueAFlatsCrease:Pressing.ArcLengthResamplingBeatsThePlainBilaplacian:\
 Pipeline.PressingStagesAndOverridesAreHonoured:Flats.WithoutFlatsTheResultIsThePlainPress:\
 Pressing.AnisotropicSpacingWorksInPhysicalSpace"
-# smooth_tests, the longest, runs as three shards.
-runs=(smooth_tests:0:3 smooth_tests:1:3 smooth_tests:2:3)
-for s in "${suites[@]}"; do if [ "$s" != smooth_tests ]; then runs+=("$s:0:1"); fi; done
+# smooth_tests, the longest, runs as four shards; the longest runs start
+# first (eval, io and extract next), so the two slots end together.
+runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 io_tests:0:1 extract_tests:0:1
+      voxart_tests:0:1 core_tests:0:1 render_tests:0:1)
 printf '%s\n' "${runs[@]}" | xargs -P "$(nproc)" -I{} sh -c '
   run=$1; t=${run%%:*}; rest=${run#*:}; i=${rest%%:*}; n=${rest#*:}
   log="$0/build-asan/$t.$i.log"

@@ -73,17 +73,24 @@ uint64_t splitmix(uint64_t& s) {
 }
 
 
-bool valid_geometry(const std::vector<Tri>& tris, std::span<const Vec3> pos) {
-  for (const Tri& t : tris)
+bool valid_geometry(const std::vector<Tri>& tris, std::span<const Vec3> pos) { return valid_with({}, tris, pos); }
+
+bool valid_with(const std::vector<Tri>& base, const std::vector<Tri>& added, std::span<const Vec3> pos) {
+  for (const Tri& t : added)
     if (detail::triangle_degenerate(pos[t[0]], pos[t[1]], pos[t[2]])) return false;
-  for (size_t i = 0; i < tris.size(); ++i)
-    for (size_t j = i + 1; j < tris.size(); ++j) {
-      const Vec3 a[3] = {pos[tris[i][0]], pos[tris[i][1]], pos[tris[i][2]]};
-      const Vec3 b[3] = {pos[tris[j][0]], pos[tris[j][1]], pos[tris[j][2]]};
-      const uint32_t ia[3] = {tris[i][0], tris[i][1], tris[i][2]};
-      const uint32_t ib[3] = {tris[j][0], tris[j][1], tris[j][2]};
-      if (detail::triangles_intersect(a, ia, b, ib)) return false;
-    }
+  auto intersect = [&](const Tri& s, const Tri& t) {
+    const Vec3 a[3] = {pos[s[0]], pos[s[1]], pos[s[2]]};
+    const Vec3 b[3] = {pos[t[0]], pos[t[1]], pos[t[2]]};
+    const uint32_t ia[3] = {s[0], s[1], s[2]};
+    const uint32_t ib[3] = {t[0], t[1], t[2]};
+    return detail::triangles_intersect(a, ia, b, ib);
+  };
+  for (size_t i = 0; i < added.size(); ++i) {
+    for (size_t j = i + 1; j < added.size(); ++j)
+      if (intersect(added[i], added[j])) return false;
+    for (const Tri& b : base)
+      if (intersect(added[i], b)) return false;
+  }
   return true;
 }
 

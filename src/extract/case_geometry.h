@@ -34,6 +34,9 @@ using Tri = std::array<uint8_t, 3>;
 /// No degenerate triangle and no two triangles intersecting beyond their
 /// shared vertices, for the positions pos[vertex id].
 bool valid_geometry(const std::vector<Tri>& tris, std::span<const Vec3> pos);
+/// valid_geometry of base + added when base is known valid: only the pairs
+/// that involve an added triangle are tested.
+bool valid_with(const std::vector<Tri>& base, const std::vector<Tri>& added, std::span<const Vec3> pos);
 /// Every triangulation of polygon `loop` (vertex order kept, so every
 /// triangle inherits the loop's orientation) that draws no diagonal inside a
 /// cube face (the neighbouring cell could draw the same edge).

@@ -26,7 +26,7 @@ using detail::Tri;
 constexpr int kLabelRobustnessSamples = 12;
 // Complete candidate triangulations ranked per case (the search stops
 // there): each costs kLabelRobustnessSamples validity checks.
-constexpr size_t kMaxCombinations = 48;
+constexpr size_t kMaxCombinations = 16;
 // Choices of alternatives (loop disc or fan, junction pairing or fan) tried
 // per case: a cube holds at most four components.
 constexpr size_t kMaxChoices = 256;
@@ -478,8 +478,7 @@ LabelCase derive(const LabelPattern& r) {
     std::function<void(size_t)> search = [&](size_t g) {
       if (g == groups.size()) {
         if (!detail::label_case_defect(sided(pick, g), true).empty()) return;
-        const std::vector<Tri> tris = assemble(pick, g);
-        if (!detail::valid_geometry(tris, mid)) return;
+        const std::vector<Tri> tris = assemble(pick, g);  // valid at the midpoints: checked group by group
         ++leaves;
         int robust = 0;
         for (const auto& sample : samples) robust += detail::valid_geometry(tris, sample) ? 1 : 0;
@@ -491,14 +490,15 @@ LabelCase derive(const LabelPattern& r) {
         }
         return;
       }
+      const std::vector<Tri> before = assemble(pick, g);
       for (size_t o = 0; o < groups[g].options.size() && leaves < kMaxCombinations; ++o) {
         pick[g] = o;
+        if (!detail::valid_with(before, groups[g].options[o], mid)) continue;
         if (!detail::label_case_defect(sided(pick, g + 1), false).empty()) continue;
-        if (!detail::valid_geometry(assemble(pick, g + 1), mid)) continue;
         search(g + 1);
       }
     };
-    if (ok) search(0);
+    if (ok && detail::valid_geometry(fixed, mid)) search(0);
     if (best_robust >= 0) {
       lc.apexes = apexes;
       lc.triangles = fan;

@@ -3,6 +3,7 @@
 // each way, one fan around each apex); with four to eight labels the
 // derivation either gives such a case or refuses (logic_error), never a
 // defective one; two labels are the binary case.
+#include <cstdlib>
 #include <set>
 
 #include "test_util.h"
@@ -45,13 +46,13 @@ TEST(LabelCases, TwoLabelsAreTheBinaryCaseWithTheLargerLabelInside) {
 }
 
 TEST(LabelCases, EveryThreeLabelPatternClosesUpPerLabel) {
+  const bool all = std::getenv("VOXPRESS_ALL_LABEL_PATTERNS") != nullptr;
   size_t n = 0;
   for (const LabelPattern& p : all_patterns(3)) {
-#ifdef VOXPRESS_SANITIZED
-    if (n++ % 16) continue;  // memory safety on a sixteenth; the Release suite derives all 5796
-#else
-    ++n;
-#endif
+    // Every third pattern (CI time); VOXPRESS_ALL_LABEL_PATTERNS=1 derives
+    // all 5796 (all pass: docs/ARCHITECTURE.md, Label maps).
+    if (!all && n++ % 3) continue;
+    if (all) ++n;
     const LabelCase& lc = label_case(p);
     EXPECT_EQ(label_case_defect(lc), "") << int(p[0]) << int(p[1]) << int(p[2]) << int(p[3]) << int(p[4]) << int(p[5])
                                           << int(p[6]) << int(p[7]);
