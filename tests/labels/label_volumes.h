@@ -52,4 +52,13 @@ inline BinaryVolume whole_mask(const ScalarVolume& v, double value) {
   return binarize(v, s);
 }
 
+// Three labels in a checkerboard: label (i + j_step * j + k) % 3 + first.
+inline ScalarVolume checkerboard3(std::array<int64_t, 3> dims, int64_t j_step = 1, int first = 1) {
+  ScalarVolume v = label_volume(dims);
+  for (int64_t k = 0; k < dims[2]; ++k)
+    for (int64_t j = 0; j < dims[1]; ++j)
+      for (int64_t i = 0; i < dims[0]; ++i) set(v, i, j, k, int((i + j_step * j + k) % 3) + first);
+  return v;
+}
+
 }  // namespace voxpress::test

@@ -109,12 +109,8 @@ TEST(Labels, PhantomEveryLabelKeepsItsSamplesInsideAndTheOthersOut) {
 
 TEST(Labels, AdversarialConfigurations) {
   {  // checkerboard of three labels: every lattice edge joins two labels
-    ScalarVolume v = label_volume({9, 8, 7});
-    for (int64_t k = 0; k < 7; ++k)
-      for (int64_t j = 0; j < 8; ++j)
-        for (int64_t i = 0; i < 9; ++i) set(v, i, j, k, int((i + j + k) % 3) + 1);
     SCOPED_TRACE("checkerboard of 3 labels");
-    expect_every_label_guaranteed(v);
+    expect_every_label_guaranteed(test::checkerboard3({9, 8, 7}));
   }
   {  // a single voxel of label 2 inside label 1
     ScalarVolume v = label_volume({7, 7, 7});

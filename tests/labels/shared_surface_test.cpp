@@ -108,16 +108,9 @@ TEST(SharedSurface, OneLabelIsTheBinaryMidpointSurface) {
 
 TEST(SharedSurface, AdversarialLabelConfigurations) {
   {  // checkerboard of three labels, and of three labels over a background
-    ScalarVolume v = label_volume({9, 8, 7});
-    for (int64_t k = 0; k < 7; ++k)
-      for (int64_t j = 0; j < 8; ++j)
-        for (int64_t i = 0; i < 9; ++i) set(v, i, j, k, int((i + j + k) % 3) + 1);
     SCOPED_TRACE("checkerboard");
-    expect_all(v);
-    for (int64_t k = 0; k < 7; ++k)
-      for (int64_t j = 0; j < 8; ++j)
-        for (int64_t i = 0; i < 9; ++i) set(v, i, j, k, int((i + 2 * j + k) % 3));
-    expect_all(v);
+    expect_all(test::checkerboard3({9, 8, 7}));
+    expect_all(test::checkerboard3({9, 8, 7}, 2, 0));
   }
   {  // a single voxel of 2 inside 1; labels touching along an edge and at a corner only
     ScalarVolume v = label_volume({10, 10, 10});
