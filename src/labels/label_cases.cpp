@@ -27,12 +27,12 @@ constexpr int kLabelRobustnessSamples = 12;
 // Complete candidate triangulations ranked per case (the search stops
 // there): each costs kLabelRobustnessSamples validity checks.
 constexpr size_t kMaxCombinations = 16;
-// Choices of alternatives (loop disc or fan, junction pairing or fan) tried
-// per case: a cube holds at most four components.
+// Choices of alternatives (loop disc or fan, junction edges or fan) tried
+// per case: the product over its components, capped.
 constexpr size_t kMaxChoices = 256;
 // Sets of junction edges kept per component: cubes of eight labels have
-// six centres of four labels and thousands of sets; the first few that
-// close up triangulate in nearly every case.
+// six centres of four labels and thousands of sets; keeping 256 instead of
+// the first 4 that close up derived no more of 2000 random patterns.
 constexpr size_t kMaxJunctionAlternatives = 4;
 // Complete sets of junction edges tried per component (a bound on the
 // enumeration's time for cubes of many labels; refused past it).
