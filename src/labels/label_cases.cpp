@@ -97,21 +97,44 @@ int find(std::vector<int>& parent, int x) {
   return x;
 }
 
-// Walks segments into one directed cycle (next[from] = to), or throws.
-std::vector<int> cycle_of(const std::vector<Seg>& segs) {
+// Directed edges (from, to) as disjoint cycles, each from its first edge's
+// start: false when a vertex starts two edges or a walk does not close on
+// its start (an open chain, or one running into another cycle).
+bool cycles_of(const std::vector<std::pair<int, int>>& edges, std::vector<std::vector<int>>& out) {
   std::map<int, int> next;
-  for (const Seg& s : segs)
-    if (!next.emplace(s.from, s.to).second) throw std::logic_error("label case: a vertex starts two segments");
-  std::vector<int> loop;
-  int x = segs[0].from;
-  do {
-    loop.push_back(x);
-    const auto it = next.find(x);
-    if (it == next.end() || loop.size() > segs.size()) throw std::logic_error("label case: open loop");
-    x = it->second;
-  } while (x != segs[0].from);
-  if (loop.size() != segs.size()) throw std::logic_error("label case: a loop visits a vertex twice");
-  return loop;
+  for (const auto& [a, b] : edges)
+    if (!next.emplace(a, b).second) return false;
+  std::map<int, bool> seen;
+  out.clear();
+  for (const auto& e : edges) {
+    if (seen[e.first]) continue;
+    std::vector<int> loop;
+    int x = e.first;
+    while (!seen[x]) {
+      seen[x] = true;
+      loop.push_back(x);
+      const auto it = next.find(x);
+      if (it == next.end()) return false;
+      x = it->second;
+    }
+    if (x != e.first) return false;
+    out.push_back(std::move(loop));
+  }
+  return true;
+}
+
+std::vector<std::pair<int, int>> edges_of(const std::vector<Seg>& segs) {
+  std::vector<std::pair<int, int>> edges;
+  for (const Seg& s : segs) edges.push_back({s.from, s.to});
+  return edges;
+}
+
+// Segments that must form one directed cycle: its vertices, or throws.
+std::vector<int> cycle_of(const std::vector<Seg>& segs) {
+  std::vector<std::vector<int>> loops;
+  if (!cycles_of(edges_of(segs), loops) || loops.size() != 1)
+    throw std::logic_error("label case: a loop's segments are not one cycle");
+  return loops[0];
 }
 
 // Labels around a centre (bit set of ranks) and its degree.
@@ -186,22 +209,10 @@ bool patches_for(const std::vector<Seg>& cs, const std::vector<std::pair<int, in
     for (bool u : used)
       if (!u) return false;  // a junction edge that no patch of the pair closes along
     // Cycles: every vertex now has one segment in and one out.
-    std::map<int, int> next;
-    for (const Seg& s : closed)
-      if (!next.emplace(s.from, s.to).second) return false;
-    std::map<int, bool> seen;
-    for (const Seg& s : closed) {
-      if (seen[s.from]) continue;
-      std::vector<int> loop;
-      int x = s.from;
-      while (!seen[x]) {
-        seen[x] = true;
-        loop.push_back(x);
-        const auto it = next.find(x);
-        if (it == next.end()) return false;
-        x = it->second;
-      }
-      if (x != s.from || loop.size() < 3) return false;
+    std::vector<std::vector<int>> loops;
+    if (!cycles_of(edges_of(closed), loops)) return false;
+    for (auto& loop : loops) {
+      if (loop.size() < 3) return false;
       out.push_back({std::move(loop), ab.first, ab.second});
     }
   }
@@ -215,7 +226,7 @@ bool patches_for(const std::vector<Seg>& cs, const std::vector<std::pair<int, in
 bool patches_close_up(const std::vector<Patch>& patches) {
   for (int L = 0; L < 8; ++L) {
     std::map<std::pair<int, int>, int> directed;
-    std::map<int, std::map<int, int>> links;  // apex -> (from -> to)
+    std::map<int, std::vector<std::pair<int, int>>> links;  // per apex: its fans' chords
     bool any = false;
     for (const Patch& p : patches) {
       if (p.in != L && p.out != L) continue;
@@ -226,7 +237,7 @@ bool patches_close_up(const std::vector<Patch>& patches) {
       for (size_t i = 0; i < k; ++i) {
         const int a = loop[i], b = loop[(i + 1) % k];
         if ((detail::vertex_faces(a) & detail::vertex_faces(b)) == 0) directed[{a, b}]++;
-        if (a >= kApex && !links[a].emplace(loop[(i + 1) % k], loop[(i + k - 1) % k]).second) return false;
+        if (a >= kApex) links[a].push_back({loop[(i + 1) % k], loop[(i + k - 1) % k]});
       }
     }
     if (!any) continue;
@@ -234,17 +245,9 @@ bool patches_close_up(const std::vector<Patch>& patches) {
       const auto back = directed.find({e.second, e.first});
       if (n != 1 || back == directed.end() || back->second != 1) return false;
     }
-    for (const auto& [apex, next] : links) {
-      int x = next.begin()->first;
-      size_t steps = 0;
-      do {
-        const auto it = next.find(x);
-        if (it == next.end()) return false;
-        x = it->second;
-        ++steps;
-      } while (x != next.begin()->first && steps <= next.size());
-      if (steps != next.size()) return false;
-    }
+    std::vector<std::vector<int>> loops;
+    for (const auto& [apex, link] : links)
+      if (!cycles_of(link, loops) || loops.size() != 1) return false;
   }
   return true;
 }
@@ -519,13 +522,14 @@ bool face_has_center(const std::array<uint8_t, 4>& q) {
   return !(q[0] == q[2] || q[1] == q[3]);
 }
 
-LabelPattern label_pattern(const std::array<uint32_t, 8>& labels, int* distinct) {
+LabelPattern label_pattern(const std::array<uint32_t, 8>& labels, int* distinct, std::array<uint32_t, 8>* values) {
   std::array<uint32_t, 8> sorted = labels;
   std::sort(sorted.begin(), sorted.end());
   const auto end = std::unique(sorted.begin(), sorted.end());
   LabelPattern p{};
   for (size_t c = 0; c < 8; ++c) p[c] = uint8_t(std::lower_bound(sorted.begin(), end, labels[c]) - sorted.begin());
   if (distinct) *distinct = int(end - sorted.begin());
+  if (values) *values = sorted;
   return p;
 }
 
@@ -567,19 +571,10 @@ std::string detail::label_case_defect(const LabelCase& c, bool complete) {
         return "label rank " + std::to_string(L) + ": inner edge " + std::to_string(e.first) + "-" +
                std::to_string(e.second) + " is not used once each way";
     }
-    for (const auto& [apex, link] : links) {  // one cycle around each apex
-      if (!complete) break;
-      std::map<int, int> next;
-      for (const auto& [a, b] : link) next[a] = b;
-      size_t steps = 0;
-      int x = link[0].first;
-      do {
-        x = next.count(x) ? next[x] : -1;
-        ++steps;
-      } while (x != link[0].first && x >= 0 && steps <= link.size());
-      if (x != link[0].first || steps != link.size())
+    std::vector<std::vector<int>> loops;
+    for (const auto& [apex, link] : links)  // one cycle around each apex
+      if (complete && (!cycles_of(link, loops) || loops.size() != 1))
         return "label rank " + std::to_string(L) + ": its triangles pinch at a fan's apex";
-    }
   }
   return {};
 }

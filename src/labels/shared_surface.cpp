@@ -98,7 +98,8 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
           }
           if (same) continue;
           int distinct = 0;
-          const LabelPattern pattern = label_pattern(c, &distinct);
+          std::array<uint32_t, 8> value{};  // of each rank
+          const LabelPattern pattern = label_pattern(c, &distinct, &value);
           const LabelCase* lc = nullptr;
           try {
             lc = &label_case(pattern);
@@ -110,9 +111,6 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
                             " labels in a way shared surfaces do not handle yet (issue 54)";
             continue;
           }
-          std::array<uint32_t, 8> sorted = c;  // rank -> value: the first `distinct` after unique
-          std::sort(sorted.begin(), sorted.end());
-          std::unique(sorted.begin(), sorted.end());
           const std::array<int64_t, 3> cube{p, q, r};
           auto vertex_key = [&](int v) {
             if (v < 12) {
@@ -131,7 +129,7 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
             apexes.push_back({keys.key(cube, 6 + k), Vec3(double(p - 1), double(q - 1), double(r - 1)) + lc->apexes[k]});
           for (const auto& t : lc->triangles)
             emitted.push_back({{vertex_key(t.v[0]), vertex_key(t.v[1]), vertex_key(t.v[2])},
-                               index_of(sorted[t.in]), index_of(sorted[t.out])});
+                               index_of(value[t.in]), index_of(value[t.out])});
         }
     }
     std::lock_guard lock(apex_mutex);

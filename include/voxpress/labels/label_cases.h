@@ -57,8 +57,10 @@ struct LabelCase {
 /// Throws std::invalid_argument if ranks are not 0..m-1 each used.
 const LabelCase& label_case(const LabelPattern& pattern);
 
-/// The pattern of eight labels (corner order), and how many distinct.
-LabelPattern label_pattern(const std::array<uint32_t, 8>& labels, int* distinct = nullptr);
+/// The pattern of eight labels (corner order), how many distinct, and the
+/// distinct values by rank (values[r] is rank r's label; the rest unset).
+LabelPattern label_pattern(const std::array<uint32_t, 8>& labels, int* distinct = nullptr,
+                           std::array<uint32_t, 8>* values = nullptr);
 
 /// True when face f's centre is a vertex for these four corner ranks in the
 /// face's square order (the face rule above; both cubes of a face agree).
