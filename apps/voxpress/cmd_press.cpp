@@ -23,7 +23,7 @@ struct PressCmd {
   std::string features;
   std::vector<std::string> disabled_passes;
   bool no_flats = false, no_sharpen = false, color_regions = false;
-  bool ascii = false, check = false;
+  bool ascii = false, check = false, separate = false;
   std::string method = "pressing";
   std::string labels, label_names, format = "ply";
   MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
@@ -188,7 +188,7 @@ void run_press(const PressCmd& c, const Global& g) {
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --labels");
     check_paths({c.input}, {{c.stats_json, OutputKind::json}});
   } else {
-    for (const char* name : {"--label-names", "--format"})
+    for (const char* name : {"--label-names", "--format", "--separate"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " needs --labels");
     check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.features, OutputKind::features}, {c.stats_json, OutputKind::json}});
   }
@@ -220,6 +220,12 @@ void run_press(const PressCmd& c, const Global& g) {
   so.overrides.mu = c.overrides.mu;
   so.extract.max_bytes = g.memory_limit();
   if (labels) {
+    // The shared surface is pressed without the feature layer (issue 54).
+    if (pressing && !c.separate)
+      for (const char* name : {"--no-flats", "--min-flat-area", "--junction-angle", "--color-regions", "--no-sharpen",
+                               "--sharp-angle", "--disable-pass", "--fit-rings"})
+        if (c.cmd->count(name))
+          throw UsageError(std::string(name) + " applies to --separate only (the shared surface has no flats yet)");
     LabelOutput o;
     o.labels = c.labels;
     o.names_file = c.label_names;
@@ -228,6 +234,7 @@ void run_press(const PressCmd& c, const Global& g) {
     o.stats_json = c.stats_json;
     o.ascii = c.ascii;
     o.check = c.check;
+    o.separate = c.separate;
     run_press_labels(c.input, c.in, so, o, g);
     return;
   }
@@ -318,6 +325,10 @@ void register_press(CLI::App& app, Global& g) {
   lm->add_option("--label-names", c->label_names, "Label names, one 'VALUE NAME' per line (segment names of a "
                                                   ".seg.nrrd are used without it)");
   lm->add_option("--format", c->format, "Mesh format of --labels: ply, obj, stl, off, glb, gltf")->capture_default_str();
+  lm->add_flag("--separate", c->separate,
+               "Mesh each label alone, with its own flats and sharpening (touching labels' surfaces are then not "
+               "shared: they may overlap near their common wall); default: one shared surface, pressed, plus "
+               "FOLDER/interfaces.ply");
   cmd->add_option("--method", c->method,
                   "Smoothing method: pressing, cesn, diamond, cell-edge, cell-size, taubin or laplacian (all but "
                   "pressing are baselines; docs/ARCHITECTURE.md)")

@@ -1,8 +1,12 @@
 // voxpress press IN --labels all|1,5,7 -o FOLDER: every selected label of a
 // label map (or every segment of a .seg.nrrd) pressed in one process, one
 // closed mesh per label, plus FOLDER/labels.json (value, name, file, counts,
-// the labels each one touches). Nothing is written unless every label
+// the labels each one touches). By default the meshes are cut from one
+// pressed shared surface (labels/shared_press.h; FOLDER/interfaces.ply holds
+// it, each interface once); --separate, a layered .seg.nrrd or a baseline
+// method meshes each label alone. Nothing is written unless every label
 // succeeds (and passes --check).
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -47,6 +51,51 @@ void check_label_output(const LabelOutput& o) {
   if (!o.names_file.empty()) check_paths({o.names_file}, {});
 }
 
+namespace {
+
+// One label's output: its mesh and what labels.json says about it.
+struct LabelPiece {
+  LabelInfo label;
+  Mesh mesh;
+  size_t flats = 0;
+};
+
+// The default: one shared surface of every label, pressed (press_shared);
+// each chosen label's closed mesh is cut from it, so touching labels share
+// their interface vertex for vertex. `combined` gets the whole surface with
+// the two labels of each triangle.
+std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vector<LabelInfo>& chosen,
+                                      const SurfaceOptions& so, Mesh& combined, nlohmann::json& stats) {
+  require_float32_room(volume.lattice, so, volume.source);
+  Stopwatch clock;
+  SharedSurface s = extract_shared_surface(volume);
+  const double t_extract = clock.seconds();
+  const SharedPressStats ps = press_shared(s, so.press);
+  stats = {{"vertices", {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}}},
+           {"junction_curves", ps.junction_curves},
+           {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
+           {"plane_curves", ps.plane_curves},
+           {"iterations", {{"junctions", ps.junctions.iterations}, {"interfaces", ps.interfaces.iterations}}},
+           {"cubes_pinned", ps.cubes_pinned},
+           {"cubes_reset", ps.cubes_reset},
+           {"seconds", {{"extract", t_extract}, {"press", ps.seconds}}}};
+  std::vector<LabelPiece> out;
+  for (const LabelInfo& l : chosen) {
+    const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
+    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), 0});
+  }
+  combined = s.mesh;
+  MeshAttribute in{"label_in", ScalarType::u32, {}}, outside{"label_out", ScalarType::u32, {}};
+  for (const auto& sd : s.sides) {
+    in.values.push_back(double(s.labels[sd[0]]));
+    outside.values.push_back(double(s.labels[sd[1]]));
+  }
+  combined.face_attributes = {std::move(in), std::move(outside)};
+  return out;
+}
+
+}  // namespace
+
 void run_press_labels(const std::string& input, const InputOptions& in, const SurfaceOptions& options,
                       const LabelOutput& o, const Global& g) {
   namespace fs = std::filesystem;
@@ -64,15 +113,25 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   const double seconds_read = clock.seconds();
   SurfaceOptions so = options;
   so.progress = bar.get();
-  const std::vector<LabelSurface> surfaces = press_labels(volume, chosen, so);
+  // Layers of a .seg.nrrd overlap: each is meshed alone, as are the baselines.
+  const bool shared = !o.separate && !table.layered && so.method == Method::pressing;
   const bool strict = keeps_classification(so.method);
+  Mesh combined;
+  nlohmann::json shared_stats;
+  std::vector<LabelPiece> pieces;
+  if (shared) {
+    pieces = shared_pieces(volume, chosen, so, combined, shared_stats);
+  } else {
+    for (LabelSurface& s : press_labels(volume, chosen, so))
+      pieces.push_back({s.label, std::move(s.result.mesh), s.result.flats.flats.size()});
+  }
 
   // File names: the label's name when it has one and no other label shares it.
   std::map<std::string, int> uses;
   for (const LabelInfo& l : chosen) ++uses[file_stem(l.name)];
   nlohmann::json list = nlohmann::json::array();
   std::vector<std::string> files;
-  for (const LabelSurface& s : surfaces) {
+  for (const LabelPiece& s : pieces) {
     const std::string stem = file_stem(s.label.name);
     // Layers of a .seg.nrrd may reuse a value: the layer is then part of the name.
     const std::string layer = table.layered ? "_layer" + std::to_string(s.label.layer) : "";
@@ -80,10 +139,10 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
                                  ? stem
                                  : "label_" + format_value(s.label.value) + layer + (stem.empty() ? "" : "_" + stem);
     files.push_back((fs::path(o.folder) / (base + "." + o.format)).string());
-    nlohmann::json e = {{"value", value_json(s.label.value)},         {"name", s.label.name},
-                        {"layer", s.label.layer},         {"file", base + "." + o.format},
-                        {"samples", s.label.samples},     {"vertices", s.result.mesh.vertex_count()},
-                        {"triangles", s.result.mesh.face_count()}, {"flats", s.result.flats.flats.size()}};
+    nlohmann::json e = {{"value", value_json(s.label.value)}, {"name", s.label.name},
+                        {"layer", s.label.layer},             {"file", base + "." + o.format},
+                        {"samples", s.label.samples},         {"vertices", s.mesh.vertex_count()},
+                        {"triangles", s.mesh.face_count()},   {"flats", s.flats}};
     nlohmann::json touches = nlohmann::json::array();
     for (const LabelContact& c : table.contacts)
       if (c.a == s.label.value || c.b == s.label.value)
@@ -91,7 +150,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
     e["touches"] = touches;
     if (o.check) {
       const BinaryVolume mask = label_mask(volume, s.label);
-      e["checks"] = check_surface(s.result.mesh, mask, bar.get(), "label " + format_value(s.label.value), strict);
+      e["checks"] = check_surface(s.mesh, mask, bar.get(), "label " + format_value(s.label.value), strict);
     }
     list.push_back(e);
   }
@@ -99,25 +158,34 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   fs::create_directories(o.folder);
   MeshWriteOptions wo;
   wo.ascii = o.ascii;
-  for (size_t i = 0; i < surfaces.size(); ++i) write_mesh(files[i], surfaces[i].result.mesh, wo);
+  for (size_t i = 0; i < pieces.size(); ++i) write_mesh(files[i], pieces[i].mesh, wo);
   nlohmann::json manifest = {{"input", input},
                              {"layered", table.layered},
+                             {"shared", shared},
                              {"lattice", lattice_json(volume.lattice)},
                              {"labels", list}};
+  if (shared) {
+    // The whole surface, each interface once, its two labels as face attributes.
+    write_mesh((fs::path(o.folder) / "interfaces.ply").string(), combined, wo);
+    manifest["interfaces"] = {{"file", "interfaces.ply"},
+                              {"vertices", combined.vertex_count()},
+                              {"triangles", combined.face_count()}};
+  }
   write_json((fs::path(o.folder) / "labels.json").string(), manifest);
   size_t vertices = 0, triangles = 0;
-  for (const LabelSurface& s : surfaces) {
-    vertices += s.result.mesh.vertex_count();
-    triangles += s.result.mesh.face_count();
+  for (const LabelPiece& s : pieces) {
+    vertices += s.mesh.vertex_count();
+    triangles += s.mesh.face_count();
   }
   if (!g.quiet)
-    std::fprintf(stderr, "%s: %zu labels%s, %zu vertices, %zu triangles, %.2f s\n", o.folder.c_str(), surfaces.size(),
+    std::fprintf(stderr, "%s: %zu labels%s, %zu vertices, %zu triangles%s, %.2f s\n", o.folder.c_str(), pieces.size(),
                  table.layered ? " (layered segmentation: each segment meshed on its own layer)" : "", vertices,
-                 triangles, clock.seconds());
+                 triangles, shared ? " (interfaces shared: interfaces.ply holds each once)" : "", clock.seconds());
   if (!o.stats_json.empty()) {
     nlohmann::json j = manifest;
     j["command"] = "press --labels";
     j["seconds"] = {{"read", seconds_read}, {"total", clock.seconds()}};
+    if (shared) j["shared_surface"] = shared_stats;
     j["peak_memory_bytes"] = peak_rss_bytes();
     write_json(o.stats_json, j);
   }

@@ -23,6 +23,7 @@
 #include "voxpress/smooth/pipeline.h"
 #include "voxpress/labels/labels.h"
 #include "voxpress/labels/shared_surface.h"
+#include "voxpress/labels/shared_press.h"
 #include "voxpress/chunk/chunked.h"
 #include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"

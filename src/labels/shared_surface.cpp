@@ -151,10 +151,14 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
                      [](const auto& a, const auto& b) { return a.first < b.first; });
   const Mat3 M = volume.lattice.index_to_physical_matrix();
   out.mesh.positions.resize(all.size());
+  out.kind.resize(all.size());
+  out.corner.resize(all.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const auto [s, kind] = keys.decode(all[i]);
       Vec3 x(double(s[0] - 1), double(s[1] - 1), double(s[2] - 1));
+      out.kind[i] = uint8_t(std::min<uint64_t>(kind, 6));
+      out.corner[i] = {s[0] - 1, s[1] - 1, s[2] - 1};
       if (kind < 3) {
         x[int(kind)] += 0.5;
       } else if (kind < 6) {

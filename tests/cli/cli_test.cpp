@@ -6,7 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
+#include <map>
+#include <set>
 
 #include "test_util.h"
 #include "voxpress/eval/truth.h"
@@ -448,6 +451,45 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
   EXPECT_TRUE(fs::exists(tmp.path("organs/left_block.ply")));
   EXPECT_TRUE(fs::exists(tmp.path("organs/ball.ply")));
   EXPECT_TRUE(fs::exists(tmp.path("organs/label_12.ply")));
+  // Shared interfaces, read back: every triangle of interfaces.ply is in the
+  // files of its two labels (the background has none), once each, with
+  // opposite orientations, at bit-identical positions; nothing else is.
+  EXPECT_TRUE(j["shared"].get<bool>());
+  const Mesh all = read_mesh(tmp.path("organs/interfaces.ply"));
+  ASSERT_EQ(all.face_attributes.size(), 2u);
+  using Key = std::array<float, 9>;
+  auto key = [](const Mesh& m, const Triangle& t, bool flip) {
+    Key k;
+    const uint32_t order[3] = {t[0], flip ? t[2] : t[1], flip ? t[1] : t[2]};
+    size_t first = 0;  // rotate the smallest vertex first: one key per oriented triangle
+    for (size_t i = 1; i < 3; ++i)
+      if (std::lexicographical_compare(m.positions[order[i]].data(), m.positions[order[i]].data() + 3,
+                                       m.positions[order[first]].data(), m.positions[order[first]].data() + 3))
+        first = i;
+    for (size_t i = 0; i < 3; ++i)
+      for (int a = 0; a < 3; ++a) k[3 * i + size_t(a)] = float(m.positions[order[(first + i) % 3]][a]);
+    return k;
+  };
+  std::map<int, std::multiset<Key>> want;  // the oriented triangles each label's file must hold
+  for (size_t f = 0; f < all.triangles.size(); ++f) {
+    const int in = int(all.face_attributes[0].values[f]), outside = int(all.face_attributes[1].values[f]);
+    if (in != 0) want[in].insert(key(all, all.triangles[f], false));
+    if (outside != 0) want[outside].insert(key(all, all.triangles[f], true));
+  }
+  for (const auto& [value, file] : {std::pair{7, "left_block.ply"}, {300, "ball.ply"}, {12, "label_12.ply"}}) {
+    const Mesh m = read_mesh(tmp.path(std::string("organs/") + file));
+    std::multiset<Key> got;
+    for (const Triangle& t : m.triangles) got.insert(key(m, t, false));
+    EXPECT_TRUE(got == want[value]) << file;
+  }
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --separate -o " + tmp.path("alone"), &out), 0)
+      << out;
+  EXPECT_FALSE(nlohmann::json::parse(test::read_file(tmp.path("alone/labels.json")))["shared"].get<bool>());
+  EXPECT_FALSE(fs::exists(tmp.path("alone/interfaces.ply")));
+  // The feature layer's options need --separate; --separate needs --labels.
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --no-flats -o " + tmp.path("none"), &out), 2);
+  EXPECT_NE(out.find("--separate"), std::string::npos) << out;
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --separate -o " + tmp.path("x.ply"), &out), 2);
   ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 300,7 --format stl -o " + tmp.path("two"), &out), 0)
       << out;
   EXPECT_EQ(fs::exists(tmp.path("two/label_300.stl")) + fs::exists(tmp.path("two/label_7.stl")), 2);

@@ -10,12 +10,12 @@
 // whole volume would give (the same sticks in the same order, only the index
 // origin moves), at the cost of the label's box instead of the volume.
 //
-// What this does not do yet (issue 54): the labels' surfaces are meshed
-// independently, so where two labels touch each places its own vertex on the
-// shared stick and the two walls are smoothed separately; each surface keeps
-// the binary guarantee for its own label (closed, 2-manifold, oriented, every
-// sample of the label inside, every other sample outside), and the surfaces
-// of two labels may cross each other near their common wall.
+// press_labels meshes the labels independently: where two labels touch each
+// places its own vertex on the shared stick and the two walls are smoothed
+// separately; each surface keeps the binary guarantee for its own label, and
+// the surfaces of two labels may cross each other near their common wall.
+// One surface shared by all labels is extract_shared_surface + press_shared
+// (shared_surface.h, shared_press.h), what `press --labels` writes by default.
 #pragma once
 
 #include <array>

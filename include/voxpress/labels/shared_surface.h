@@ -10,9 +10,8 @@
 // closed surface is its triangles, those of which it is `out` reversed. A
 // label against the background alone gives exactly the binary midpoint
 // surface (extract_sticks, t = 0.5). This is the midpoint surface: every
-// vertex at its stick's midpoint, its face's or its case's centre; the
-// smoothing of shared surfaces (Pressing with junction curves) is not done
-// yet.
+// vertex at its stick's midpoint, its face's or its case's centre;
+// press_shared (shared_press.h) smooths it.
 #pragma once
 
 #include <array>
@@ -29,6 +28,12 @@ struct SharedSurface {
   std::vector<uint32_t> labels;  ///< label values by index; index 0 is the background, 0
   Mesh mesh;                     ///< physical positions; every interface triangle once
   std::vector<std::array<uint32_t, 2>> sides;  ///< per triangle: (in, out) label indices
+  /// Per vertex, what it lies on: kind 0-2 a stick along that axis, 3-5 a
+  /// face normal to axis kind - 3, 6 an apex inside a cube; `corner` the
+  /// (unpadded, may be -1) index of the stick's lower sample or of the
+  /// face's or the cube's lowest corner.
+  std::vector<uint8_t> kind;
+  std::vector<std::array<int64_t, 3>> corner;
   uint64_t stick_vertices = 0, face_vertices = 0, apex_vertices = 0;
 };
 

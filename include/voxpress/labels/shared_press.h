@@ -1,0 +1,55 @@
+// voxpress/labels/shared_press.h — Pressing of a label map's shared surface
+// (issue 54; Chica et al., Section 4, extended to several labels).
+//
+// Two stages, one direction:
+//  1. Junction lines. Edges of the shared surface where three or more
+//     interfaces meet (three or more triangles on one edge) form the
+//     junction lines; they are smoothed as 1-D curves in space with the same
+//     bilaplacian on arc length, each face-centre vertex kept inside its
+//     face square, each apex inside its cube. Points where a line branches
+//     or ends, and vertices around which four or more labels meet, stay fixed.
+//  2. Interfaces. On each lattice plane the surface's cut is a network of
+//     labelled contours: curves of stick vertices between junction points
+//     (the face-centre vertices of the plane's faces). Every curve is
+//     pressed as in the binary case, the junction points as fixed barriers
+//     (PressOptions::free_ends applies to the pieces between them); each
+//     stick vertex slides along its stick and averages its two planes'
+//     proposals.
+// Every vertex stays in its element (stick, face, cube), away from the
+// lattice samples by the margin, and every triangle lies in one cube: a
+// cube's corner is an extreme point of the cube, so no triangle of the cube
+// can contain it while its vertices move. So no sample changes side: each
+// sample stays inside its own label's closed surface and outside every other.
+// Then the result is checked cube by cube with exact predicates (triangles
+// of different cubes meet only in the shared faces' contour segments): the
+// vertices of a cube whose triangles intersect or degenerate are pinned at
+// their midpoints and both stages run again around them; a cube that still
+// fails is put back at its midpoints (where every label case is free of
+// intersection), rechecking the cubes that share its vertices. So the
+// pressed surface is free of self-intersection by construction.
+#pragma once
+
+#include <cstddef>
+
+#include "voxpress/labels/shared_surface.h"
+#include "voxpress/smooth/pressing.h"
+
+namespace voxpress {
+
+struct SharedPressStats {
+  size_t junction_curves = 0;    ///< junction lines (open between fixed points, or closed)
+  size_t junction_moving = 0;    ///< their vertices that move
+  size_t junction_fixed = 0;     ///< junction vertices kept in place (branch and end points, 4+ labels)
+  size_t plane_curves = 0;       ///< pieces of labelled contours and closed contours on the planes
+  size_t cubes_pinned = 0;       ///< cubes that failed the exact check and were pressed again pinned
+  size_t cubes_reset = 0;        ///< cubes put back at their midpoints after that
+  PressStats junctions, interfaces;
+  double seconds = 0;
+};
+
+/// Presses the shared surface in place (mesh positions). `options` drives
+/// both stages (iterations, step, arc length, margin, levels, momentum,
+/// circle correction, free ends). Deterministic for any thread count.
+SharedPressStats press_shared(SharedSurface& surface, const PressOptions& options = {});
+
+}  // namespace voxpress

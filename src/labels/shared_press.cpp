@@ -1,0 +1,439 @@
+// Pressing of a shared surface: junction lines as curves in space, then the
+// labelled contours of every lattice plane with the junction points as
+// barriers. Theory of operation: include/voxpress/labels/shared_press.h.
+#include "voxpress/labels/shared_press.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "core/clearance.h"
+#include "core/predicates.h"
+#include "core/sentinel.h"
+#include "core/timing.h"
+#include "smooth/curve_kernel.h"
+
+namespace voxpress {
+namespace {
+
+using detail::kNone;
+
+bool is_stick(uint8_t kind) { return kind < 3; }
+bool is_face(uint8_t kind) { return kind >= 3 && kind < 6; }
+
+// The plane of family a (normal to axis a) a vertex lies in, or INT64_MIN.
+int64_t plane_of(const SharedSurface& s, uint32_t v, int a) {
+  const uint8_t k = s.kind[v];
+  if ((is_stick(k) && k != a) || (is_face(k) && k - 3 == a)) return s.corner[v][size_t(a)];
+  return INT64_MIN;
+}
+
+// Undirected edges (u < v) with the number of triangles on each.
+struct Edge {
+  uint32_t u, v, count;
+};
+
+std::vector<Edge> edges_of(const Mesh& m) {
+  std::vector<uint64_t> keys(3 * m.triangles.size());
+  tbb::parallel_for(size_t(0), m.triangles.size(), [&](size_t f) {
+    const Triangle& t = m.triangles[f];
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = t[size_t(e)], b = t[size_t((e + 1) % 3)];
+      keys[3 * f + size_t(e)] = (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+    }
+  });
+  tbb::parallel_sort(keys.begin(), keys.end());
+  std::vector<Edge> out;
+  for (size_t i = 0; i < keys.size();) {
+    size_t j = i;
+    while (j < keys.size() && keys[j] == keys[i]) ++j;
+    out.push_back({uint32_t(keys[i] >> 32), uint32_t(keys[i]), uint32_t(j - i)});
+    i = j;
+  }
+  return out;
+}
+
+// Adjacency in CSR form of a list of undirected edges over n vertices.
+struct Graph {
+  std::vector<uint32_t> offset, to, edge;  // edge: the index of the edge in the list
+  Graph(size_t n, const std::vector<std::pair<uint32_t, uint32_t>>& edges) : offset(n + 1, 0) {
+    for (const auto& [u, v] : edges) ++offset[u + 1], ++offset[v + 1];
+    for (size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
+    to.resize(offset[n]);
+    edge.resize(offset[n]);
+    std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
+    for (uint32_t e = 0; e < edges.size(); ++e) {
+      const auto [u, v] = edges[e];
+      to[fill[u]] = v, edge[fill[u]++] = e;
+      to[fill[v]] = u, edge[fill[v]++] = e;
+    }
+  }
+  uint32_t degree(uint32_t v) const { return offset[v + 1] - offset[v]; }
+};
+
+// The chains of a graph between its `stop` vertices (each chain from a stop
+// vertex to a stop vertex, possibly the same one, both ends listed), then its
+// closed loops of other vertices (every other vertex has degree 2). Each edge is walked once. Chains start at stop vertices
+// in increasing order, so the result does not depend on threads.
+struct Chains {
+  std::vector<uint32_t> ids, offsets{0};
+  std::vector<uint8_t> closed;
+};
+
+Chains chains_of(const Graph& g, const std::vector<uint8_t>& stop, const std::vector<uint32_t>& members) {
+  Chains c;
+  std::vector<uint8_t> walked(g.to.size() / 2, 0);
+  auto walk = [&](uint32_t start, uint32_t k) {  // k: position in start's adjacency
+    uint32_t v = start;
+    c.ids.push_back(v);
+    for (;;) {
+      walked[g.edge[k]] = 1;
+      const uint32_t w = g.to[k];
+      if (stop[w] || w == start) break;
+      c.ids.push_back(w);
+      // The other edge of w (w has degree 2: it is not a stop vertex).
+      uint32_t next = kNone;
+      for (uint32_t q = g.offset[w]; q < g.offset[w + 1]; ++q)
+        if (!walked[g.edge[q]]) next = q;
+      if (next == kNone) break;  // a loop closed back onto w's first edge
+      v = w;
+      k = next;
+    }
+    return g.to[k];
+  };
+  for (uint32_t v : members) {
+    if (!stop[v]) continue;
+    for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
+      if (walked[g.edge[k]]) continue;
+      c.ids.push_back(walk(v, k));  // the far end (v again for a chain back to v)
+      c.offsets.push_back(uint32_t(c.ids.size()));
+      c.closed.push_back(0);
+    }
+  }
+  for (uint32_t v : members) {
+    if (stop[v] || g.degree(v) == 0) continue;
+    bool fresh = false;
+    for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) fresh = fresh || !walked[g.edge[k]];
+    if (!fresh) continue;
+    walk(v, g.offset[v]);
+    c.offsets.push_back(uint32_t(c.ids.size()));
+    c.closed.push_back(1);
+  }
+  return c;
+}
+
+
+// Stage 1: the junction lines as curves in space (PressOptions drives the
+// iteration as it drives pressing: coarse-to-fine arc length, momentum,
+// circle correction; Jacobi updates). x: index positions, updated in place.
+PressStats press_junctions(const SharedSurface& s, const Chains& c, const std::vector<uint8_t>& moving,
+                           std::vector<Vec3>& x, const PressOptions& o, int levels) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PressStats st;
+  st.levels = levels;
+  st.curves = c.closed.size();
+  const Mat3 M = s.lattice.index_to_physical_matrix(), Minv = M.inverse();
+  const double cell = std::cbrt(s.lattice.spacing[0] * s.lattice.spacing[1] * s.lattice.spacing[2]);
+  const double s2 = o.step * o.step;
+  const double correction = 1 - std::cos(std::clamp(o.circle_correction, 0.0, 90.0) * std::numbers::pi / 180);
+  std::vector<Vec3> disp(x.size(), Vec3::Zero()), velocity(x.size(), Vec3::Zero());
+  for (uint8_t m : moving) st.fresh += m;
+  if (st.fresh == 0) return st;
+  for (int it = 0; it < o.iterations; ++it) {
+    const int stage = std::min(levels - 1, it * levels / std::max(o.iterations, 1));
+    const double d = o.arc_length * double(1 << (levels - 1 - stage)) * cell;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, c.closed.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+      detail::Scratch<Vec3> w;
+      for (size_t k = r.begin(); k < r.end(); ++k) {
+        const uint32_t b = c.offsets[k], n = c.offsets[k + 1] - b;
+        w.resize(n);
+        for (uint32_t i = 0; i < n; ++i) w.pos[i] = M * x[c.ids[b + i]];
+        detail::curve_step(n, c.closed[k] != 0, d, s2, o.resample, false, correction, detail::Euclid{}, w);
+        for (uint32_t i = 0; i < n; ++i)
+          if (moving[c.ids[b + i]]) disp[c.ids[b + i]] = Minv * w.disp[i];
+      }
+    });
+    const double change = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, x.size(), 1 << 12), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double acc) {
+          for (size_t v = r.begin(); v < r.end(); ++v) {
+            if (!moving[v]) continue;
+            // Within its element: a face keeps its normal coordinate, both
+            // keep the margin from the element's sides.
+            Vec3 y = x[v] + disp[v] + o.momentum * velocity[v];
+            for (int a = 0; a < 3; ++a) {
+              const double lo = double(s.corner[v][size_t(a)]);
+              y[a] = is_face(s.kind[v]) && s.kind[v] - 3 == a ? lo : std::clamp(y[a], lo + o.margin, lo + 1 - o.margin);
+            }
+            velocity[v] = y - x[v];
+            acc = std::max(acc, velocity[v].cwiseAbs().maxCoeff());
+            x[v] = y;
+          }
+          return acc;
+        },
+        [](double a, double b) { return std::max(a, b); });
+    st.iterations = it + 1;
+    st.last_max_change = change;
+    st.least_max_change = it == 0 ? change : std::min(st.least_max_change, change);
+    if (change < o.tolerance) break;
+  }
+  st.seconds = detail::seconds_since(t0);
+  return st;
+}
+
+// The triangles of each cube (every triangle lies in one cube: its
+// midpoint centroid is strictly inside it, as no triangle has its three
+// vertices on one face), as groups of a CSR list, and for each vertex the
+// groups it has triangles in.
+struct Cubes {
+  std::vector<uint32_t> tris, offsets{0};
+  std::vector<uint32_t> vertex_offsets, vertex_groups;
+};
+
+Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0) {
+  Cubes c;
+  const size_t nt = m.triangles.size();
+  std::vector<std::pair<std::array<int64_t, 3>, uint32_t>> key(nt);
+  tbb::parallel_for(size_t(0), nt, [&](size_t f) {
+    const Triangle& t = m.triangles[f];
+    const Vec3 g = (x0[t[0]] + x0[t[1]] + x0[t[2]]) / 3;
+    key[f] = {{int64_t(std::floor(g[0])), int64_t(std::floor(g[1])), int64_t(std::floor(g[2]))}, uint32_t(f)};
+  });
+  tbb::parallel_sort(key.begin(), key.end());
+  for (size_t i = 0; i < nt; ++i) {
+    if (i > 0 && key[i].first != key[i - 1].first) c.offsets.push_back(uint32_t(i));
+    c.tris.push_back(key[i].second);
+  }
+  if (nt > 0) c.offsets.push_back(uint32_t(nt));
+  std::vector<std::pair<uint32_t, uint32_t>> vg;  // (vertex, group)
+  for (uint32_t g = 0; g + 1 < c.offsets.size(); ++g)
+    for (uint32_t k = c.offsets[g]; k < c.offsets[g + 1]; ++k)
+      for (uint32_t v : m.triangles[c.tris[k]]) vg.push_back({v, g});
+  tbb::parallel_sort(vg.begin(), vg.end());
+  vg.erase(std::unique(vg.begin(), vg.end()), vg.end());
+  c.vertex_offsets.assign(x0.size() + 1, 0);
+  for (const auto& [v, g] : vg) ++c.vertex_offsets[v + 1], c.vertex_groups.push_back(g);
+  for (size_t v = 0; v < x0.size(); ++v) c.vertex_offsets[v + 1] += c.vertex_offsets[v];
+  return c;
+}
+
+// Is the surface inside cube group g valid once stored in float32: no
+// triangle with an altitude under delta (cells), no two triangles meeting
+// or within delta of each other beyond what they share (exact predicates;
+// core/clearance.h)? Triangles of different cubes meet only in the segments
+// a shared face's contour is made of, which both cubes use: so a surface
+// whose every cube passes is free of self-intersection.
+bool cube_ok(const Mesh& m, const Cubes& c, uint32_t g, const std::vector<Vec3>& x, double delta) {
+  for (uint32_t i = c.offsets[g]; i < c.offsets[g + 1]; ++i) {
+    const Triangle& a = m.triangles[c.tris[i]];
+    const Vec3 pa[3] = {x[a[0]], x[a[1]], x[a[2]]};
+    if (detail::triangle_degenerate(pa[0], pa[1], pa[2]) || detail::triangle_altitude(pa[0], pa[1], pa[2]) < delta)
+      return false;
+    const uint32_t ia[3] = {a[0], a[1], a[2]};
+    for (uint32_t j = c.offsets[g]; j < i; ++j) {
+      const Triangle& b = m.triangles[c.tris[j]];
+      const Vec3 pb[3] = {x[b[0]], x[b[1]], x[b[2]]};
+      const uint32_t ib[3] = {b[0], b[1], b[2]};
+      if (detail::triangles_intersect(pa, ia, pb, ib) || detail::triangles_within(pa, ia, pb, ib, delta)) return false;
+    }
+  }
+  return true;
+}
+
+// The failing groups among `groups` (increasing).
+std::vector<uint32_t> failing(const Mesh& m, const Cubes& c, const std::vector<uint32_t>& groups,
+                              const std::vector<Vec3>& x, double delta) {
+  std::vector<uint8_t> bad(groups.size(), 0);
+  tbb::parallel_for(size_t(0), groups.size(), [&](size_t k) { bad[k] = !cube_ok(m, c, groups[k], x, delta); });
+  std::vector<uint32_t> out;
+  for (size_t k = 0; k < groups.size(); ++k)
+    if (bad[k]) out.push_back(groups[k]);
+  return out;
+}
+
+}  // namespace
+
+SharedPressStats press_shared(SharedSurface& s, const PressOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SharedPressStats st;
+  const size_t n = s.mesh.positions.size();
+  if (s.kind.size() != n || s.corner.size() != n) throw std::invalid_argument("press_shared: vertex kinds missing");
+  // Index positions of the midpoint surface; t of the stick vertices.
+  std::vector<Vec3> x0(n);
+  std::vector<double> t0s(n, 0);
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    x0[v] = s.lattice.to_index(s.mesh.positions[v]);
+    if (is_stick(s.kind[v])) t0s[v] = x0[v][s.kind[v]] - double(s.corner[v][s.kind[v]]);
+  });
+  int64_t extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    int64_t lo = INT64_MAX, hi = INT64_MIN;
+    for (const auto& c : s.corner) lo = std::min(lo, c[size_t(a)]), hi = std::max(hi, c[size_t(a)]);
+    if (n > 0) extent = std::max(extent, hi + 2 - lo);
+  }
+  const int levels = press_levels_for_extent(o.levels, extent);
+  const std::vector<Edge> edges = edges_of(s.mesh);
+
+  // Junction lines: edges with three or more triangles.
+  std::vector<std::pair<uint32_t, uint32_t>> junction;
+  for (const Edge& e : edges)
+    if (e.count >= 3) junction.push_back({e.u, e.v});
+  const Graph jg(n, junction);
+  // Labels around each junction vertex, up to four.
+  std::vector<std::array<uint32_t, 4>> around(n);
+  std::vector<uint8_t> count(n, 0);
+  for (size_t f = 0; f < s.sides.size(); ++f)
+    for (uint32_t v : s.mesh.triangles[f])
+      for (uint32_t L : s.sides[f]) {
+        if (jg.degree(v) == 0 || count[v] == 4) continue;
+        if (std::find(around[v].begin(), around[v].begin() + count[v], L) == around[v].begin() + count[v])
+          around[v][count[v]++] = L;
+      }
+  std::vector<uint32_t> members;
+  for (uint32_t v = 0; v < n; ++v)
+    if (jg.degree(v) > 0) members.push_back(v);
+
+  // The labelled contours of every plane, cut at the junction points.
+  std::vector<uint8_t> barrier(n, 0);
+  for (uint32_t v = 0; v < n; ++v) barrier[v] = !is_stick(s.kind[v]) || jg.degree(v) > 0;
+  std::vector<detail::Family> families(3);
+  std::vector<uint32_t> ids[3], offsets[3];
+  const Mat3 M = s.lattice.index_to_physical_matrix();
+  for (int a = 0; a < 3; ++a) {
+    const int u = (a + 1) % 3, w = (a + 2) % 3;
+    std::vector<std::pair<uint32_t, uint32_t>> in_plane;
+    for (const Edge& e : edges) {
+      const int64_t p = plane_of(s, e.u, a);
+      if (p != INT64_MIN && p == plane_of(s, e.v, a)) in_plane.push_back({e.u, e.v});
+    }
+    const Graph g(n, in_plane);
+    std::vector<uint32_t> mem;
+    for (uint32_t v = 0; v < n; ++v) {
+      if (plane_of(s, v, a) == INT64_MIN) continue;
+      if (is_stick(s.kind[v]) && g.degree(v) != 2)
+        throw std::logic_error("press_shared: a stick vertex without two neighbours in a plane");
+      mem.push_back(v);
+    }
+    const Chains pc = chains_of(g, barrier, mem);
+    // CSR curves for the iteration: an open chain J1 .. J2 as a cycle whose
+    // closing segment J2 -> J1 joins two barriers (no vertex between them).
+    for (size_t k = 0; k < pc.closed.size(); ++k) {
+      uint32_t b = pc.offsets[k], e = pc.offsets[k + 1];
+      if (!pc.closed[k] && pc.ids[e - 1] == pc.ids[b]) --e;
+      ids[a].insert(ids[a].end(), pc.ids.begin() + b, pc.ids.begin() + e);
+      offsets[a].push_back(uint32_t(ids[a].size()));
+    }
+    offsets[a].insert(offsets[a].begin(), 0u);
+    st.plane_curves += pc.closed.size();
+    detail::Family& f = families[size_t(a)];
+    f.ids = &ids[a];
+    f.offsets = &offsets[a];
+    f.g = {M.col(u).squaredNorm(), M.col(u).dot(M.col(w)), M.col(w).squaredNorm()};
+    f.cell = std::sqrt(s.lattice.spacing[u] * s.lattice.spacing[w]);
+    const size_t m = ids[a].size();
+    f.base.resize(m);
+    f.mov.resize(m);
+    f.dst.resize(m);
+    for (size_t k = 0; k < m; ++k) {
+      const uint32_t v = ids[a][k];
+      const uint8_t kind = s.kind[v];
+      f.mov[k] = uint8_t(is_stick(kind) && kind != u ? 1 : 0);
+      f.dst[k] = 2 * v + uint32_t(is_stick(kind) ? SliceCurves::slot(a, kind) : 0);
+      if (is_stick(kind)) f.base[k] = Vec2(double(s.corner[v][size_t(u)]), double(s.corner[v][size_t(w)]));
+    }
+  }
+
+  const Cubes cubes = cubes_of(s.mesh, x0);
+  const double delta = detail::float32_clearance(s.lattice);
+  std::vector<uint32_t> all(cubes.offsets.size() - 1);
+  for (uint32_t g = 0; g < all.size(); ++g) all[g] = g;
+  // One pressing of both stages; `pinned` vertices keep their midpoint place.
+  std::vector<Vec3> x;
+  std::vector<uint8_t> pinned(n, 0);
+  auto run = [&] {
+    x = x0;
+    std::vector<double> t = t0s;
+    std::vector<uint8_t> moving(n, 0), stop(n, 0);
+    st.junction_moving = st.junction_fixed = 0;
+    for (uint32_t v : members) {
+      moving[v] = jg.degree(v) == 2 && !is_stick(s.kind[v]) && count[v] < 4 && !pinned[v];
+      stop[v] = !moving[v];
+      (moving[v] ? st.junction_moving : st.junction_fixed)++;
+    }
+    const Chains jc = chains_of(jg, stop, members);
+    st.junction_curves = jc.closed.size();
+    st.junctions = press_junctions(s, jc, moving, x, o, levels);
+    for (int a = 0; a < 3; ++a) {  // junction points at their pressed places (t = 0)
+      const int u = (a + 1) % 3, w = (a + 2) % 3;
+      detail::Family& f = families[size_t(a)];
+      for (size_t k = 0; k < ids[a].size(); ++k)
+        if (!is_stick(s.kind[ids[a][k]])) f.base[k] = Vec2(x[ids[a][k]][u], x[ids[a][k]][w]);
+    }
+    std::vector<uint8_t> frozen(barrier);
+    for (uint32_t v = 0; v < n; ++v) frozen[v] |= pinned[v];
+    st.interfaces = detail::iterate(t, families, 2, frozen, barrier, o, levels);
+    tbb::parallel_for(size_t(0), n, [&](size_t v) {
+      if (!is_stick(s.kind[v]) || jg.degree(v) > 0) return;  // junction sticks stay at x0
+      Vec3 y(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
+      y[s.kind[v]] += t[v];
+      x[v] = y;
+    });
+  };
+  // The checked result: press, check every cube exactly; pin the vertices
+  // of the cubes that fail and press again, so the pressing works around
+  // them; then put the vertices of any cube that still fails back at their
+  // midpoints, and recheck the cubes that share them, until none fails.
+  // A cube whose vertices are all at their midpoints passes (the label
+  // cases are intersection-free there, and clear of each other by far more
+  // than float32 rounding), so this ends, every cube valid in float32.
+  auto pin = [&](const std::vector<uint32_t>& bad) {
+    for (uint32_t g : bad)
+      for (uint32_t k = cubes.offsets[g]; k < cubes.offsets[g + 1]; ++k)
+        for (uint32_t v : s.mesh.triangles[cubes.tris[k]]) pinned[v] = 1;
+  };
+  run();
+  std::vector<uint32_t> bad = failing(s.mesh, cubes, all, x, delta);
+  if (!bad.empty()) {
+    st.cubes_pinned = bad.size();
+    pin(bad);
+    run();
+    bad = failing(s.mesh, cubes, all, x, delta);
+  }
+  std::vector<uint8_t> reset(n, 0);
+  while (!bad.empty()) {
+    std::vector<uint32_t> touched;
+    for (uint32_t g : bad) {
+      bool fresh = false;  // a cube already all at its midpoints cannot do better: left as it is
+      for (uint32_t k = cubes.offsets[g]; k < cubes.offsets[g + 1]; ++k)
+        for (uint32_t v : s.mesh.triangles[cubes.tris[k]]) fresh = fresh || !reset[v];
+      st.cubes_reset += fresh;
+      if (!fresh) continue;
+      for (uint32_t k = cubes.offsets[g]; k < cubes.offsets[g + 1]; ++k)
+        for (uint32_t v : s.mesh.triangles[cubes.tris[k]]) {
+          if (reset[v]) continue;
+          reset[v] = 1;
+          x[v] = x0[v];
+          touched.insert(touched.end(), cubes.vertex_groups.begin() + cubes.vertex_offsets[v],
+                         cubes.vertex_groups.begin() + cubes.vertex_offsets[v + 1]);
+        }
+    }
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    bad = failing(s.mesh, cubes, touched, x, delta);
+  }
+  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    if (x[v] != x0[v]) s.mesh.positions[v] = s.lattice.to_physical(x[v]);  // the others keep their bits
+  });
+  s.mesh.normals.clear();
+  st.seconds = detail::seconds_since(t0);
+  return st;
+}
+
+}  // namespace voxpress

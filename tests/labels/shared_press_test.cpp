@@ -1,0 +1,72 @@
+// Pressing of shared surfaces: the pressed phantom keeps every guarantee of
+// the midpoint surface (every label closed, 2-manifold, outward, free of
+// self-intersection, every sample of the whole map on its side, checked in
+// double and float32; interfaces shared, no gap, no overlap), moves its
+// junction lines, and a label meeting one other label alone is pressed as
+// the binary press of its mask; the same bytes for 1 and N threads.
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "label_volumes.h"
+#include "test_util.h"
+
+namespace voxpress {
+namespace {
+
+// Distance error of the phantom's nested sphere (label 3: radius 5 about
+// x = 7 in the phantom's rotated frame, label_volumes.h), RMS over a mesh.
+double sphere3_rms(const Mesh& m) {
+  const double c = std::cos(0.4), s = std::sin(0.4);
+  const Vec3 centre = Vec3(-12.5, 40.25, 7) + Vec3(22, 24, 22.5);
+  double sum = 0;
+  for (const Vec3& p : m.positions) {
+    const Vec3 q = p - centre;
+    const double x = c * q.x() - s * q.y(), y = s * q.x() + c * q.y();
+    const double e = std::sqrt((x - 7) * (x - 7) + y * y + q.z() * q.z()) - 5;
+    sum += e * e;
+  }
+  return std::sqrt(sum / double(m.positions.size()));
+}
+
+TEST(SharedPress, PressedPhantomKeepsEveryGuarantee) {
+  const ScalarVolume v = test::phantom();
+  const SharedSurface mid = extract_shared_surface(v);
+  SharedSurface s = mid;
+  const SharedPressStats st = press_shared(s);
+  EXPECT_GT(st.junction_curves, 0u);
+  EXPECT_GT(st.junction_moving, 0u);
+  EXPECT_GT(st.interfaces.iterations, 1);
+  size_t moved_faces = 0;
+  for (size_t i = 0; i < s.mesh.positions.size(); ++i)
+    moved_faces += s.kind[i] >= 3 && s.kind[i] < 6 && (s.mesh.positions[i] - mid.mesh.positions[i]).norm() > 1e-3;
+  EXPECT_GT(moved_faces, 0u) << "the junction lines were not smoothed";
+  for (uint32_t L = 1; L < s.labels.size(); ++L) {
+    SCOPED_TRACE("label " + std::to_string(s.labels[L]));
+    test::expect_guarantees(label_mesh(s, L), test::whole_mask(v, double(s.labels[L])));
+  }
+  EXPECT_EQ(s.mesh.triangles, mid.mesh.triangles);  // pressing moves vertices only
+  // The nested sphere meets label 2 alone: its surface is the binary press
+  // of its mask, and it is far closer to the true sphere than the midpoints.
+  const Mesh pressed3 = label_mesh(s, 3), mid3 = label_mesh(mid, 3);
+  StickSurface binary = extract_sticks(test::whole_mask(v, 3));
+  press(binary);
+  EXPECT_NEAR(sphere3_rms(pressed3), sphere3_rms(to_mesh(binary)), 1e-9);
+  EXPECT_LT(sphere3_rms(pressed3), 0.5 * sphere3_rms(mid3));
+}
+
+TEST(SharedPress, SameBytesForOneAndManyThreads) {
+  const ScalarVolume v = test::checkerboard3({9, 8, 7}, 2, 0);
+  SharedSurface one = extract_shared_surface(v), many = one;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    press_shared(one);
+  }
+  press_shared(many);
+  EXPECT_EQ(one.mesh.positions, many.mesh.positions);
+  for (uint32_t L = 1; L < one.labels.size(); ++L)
+    test::expect_guarantees(label_mesh(one, L), test::whole_mask(v, double(one.labels[L])));
+}
+
+}  // namespace
+}  // namespace voxpress
