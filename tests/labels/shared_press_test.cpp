@@ -7,6 +7,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "label_volumes.h"
 #include "test_util.h"
@@ -53,6 +54,61 @@ TEST(SharedPress, PressedPhantomKeepsEveryGuarantee) {
   press(binary);
   EXPECT_NEAR(sphere3_rms(pressed3), sphere3_rms(to_mesh(binary)), 1e-9);
   EXPECT_LT(sphere3_rms(pressed3), 0.5 * sphere3_rms(mid3));
+}
+
+// Every label of the pressed surface keeps every guarantee (double and
+// float32), and pressing moved the surface.
+void expect_pressed(const ScalarVolume& v) {
+  const SharedSurface mid = extract_shared_surface(v);
+  SharedSurface s = mid;
+  press_shared(s);
+  EXPECT_NE(s.mesh.positions, mid.mesh.positions);
+  for (uint32_t L = 1; L < s.labels.size(); ++L) {
+    SCOPED_TRACE("label " + std::to_string(s.labels[L]));
+    test::expect_guarantees(label_mesh(s, L), test::whole_mask(v, double(s.labels[L])));
+  }
+}
+
+TEST(SharedPress, AdversarialLabelConfigurationsKeepEveryGuarantee) {
+  {
+    SCOPED_TRACE("checkerboards");
+    expect_pressed(test::checkerboard3({9, 8, 7}));
+    expect_pressed(test::checkerboard3({10, 9, 8}, 2, 0));
+  }
+  {  // a single voxel of 2 inside 1; labels touching along an edge and at a corner only
+    ScalarVolume v = test::label_volume({10, 10, 10});
+    for (int64_t k = 1; k < 5; ++k)
+      for (int64_t j = 1; j < 5; ++j)
+        for (int64_t i = 1; i < 5; ++i) test::set(v, i, j, k, 1);
+    test::set(v, 2, 2, 2, 2);
+    test::set(v, 6, 6, 6, 3);
+    test::set(v, 7, 7, 6, 4);
+    test::set(v, 7, 7, 7, 5);
+    SCOPED_TRACE("voxel inside, edge and corner contacts");
+    expect_pressed(v);
+  }
+  for (int seed = 0; seed < 3; ++seed) {  // three labels at random: junctions everywhere
+    ScalarVolume v = test::label_volume({12, 11, 10}, {1, 1.3, 0.8});
+    test::Rng r3{uint64_t(seed)};
+    for (auto& b : v.bytes) b = std::byte(uint8_t(r3.range(0, 2)));
+    SCOPED_TRACE("noise " + std::to_string(seed));
+    expect_pressed(v);
+  }
+}
+
+// The 61-label TotalSegmentator map: every label closed, 2-manifold,
+// oriented, free of self-intersection, 0 violations, in double and float32.
+TEST(SharedPress, SixtyOneLabelMap) {
+  const std::string path = test::shared_data() + "/medical/totalseg_example_seg_fast_force_split.nii.gz";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared is absent: " << path;
+  const ScalarVolume v = read_volume(path);
+  SharedSurface s = extract_shared_surface(v);
+  const SharedPressStats st = press_shared(s);
+  EXPECT_GT(st.junction_moving, 0u);
+  for (uint32_t L = 1; L < s.labels.size(); ++L) {
+    SCOPED_TRACE("label " + std::to_string(s.labels[L]));
+    test::expect_guarantees(label_mesh(s, L), test::whole_mask(v, double(s.labels[L])));
+  }
 }
 
 TEST(SharedPress, SameBytesForOneAndManyThreads) {
