@@ -7,7 +7,7 @@
 // of the label's mask alone; for the junction vertices (face centres and
 // apexes), their distance to the true triple lines. Prints Markdown tables
 // (docs/BENCHMARKS.md).
-//   build/bench/bench_labels [--seeds N] [--scale S]
+//   build/bench/bench_labels [--seeds N] [--scale S] [--iterations N]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -107,6 +107,8 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "Random rotations")->check(CLI::Range(1, 100));
   app.add_option("--scale", scale, "Solid size in units of the tests' phantom (1: 44 x 40 x 30 samples)")
       ->check(CLI::Range(0.5, 8.0));
+  PressOptions po;
+  app.add_option("--iterations", po.iterations, "Pressing iterations (both stages, and the binary press)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   const Vec3 spacing(1, 1.2, 1.5);
   const double cell = std::cbrt(spacing.prod());
@@ -139,7 +141,7 @@ int main(int argc, char** argv) {
     const SharedSurface mid = extract_shared_surface(v);
     SharedSurface s = mid;
     double t0 = now();
-    const SharedPressStats st = press_shared(s);
+    const SharedPressStats st = press_shared(s, po);
     t_shared += now() - t0;
     for (uint32_t L = 1; L < s.labels.size(); ++L) {
       const int value = int(s.labels[L]);
@@ -157,7 +159,7 @@ int main(int argc, char** argv) {
       sel.value = value;
       t0 = now();
       StickSurface b = extract_sticks(binarize(v, sel));
-      press(b);
+      press(b, po);
       t_binary += now() - t0;
       const Mesh bm = to_mesh(b);
       r.binary += rms(bm) * double(pm.positions.size()) / double(bm.positions.size());

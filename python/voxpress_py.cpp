@@ -235,12 +235,23 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
 }
 
 // Every label of a label map: {value: Mesh}, as `press --labels` computes it.
-py::dict py_press_labels(const py::object& array_like, const py::object& labels, const py::object& spacing,
-                         const py::object& origin, const py::object& direction, const std::string& method,
-                         const std::string& axes, const py::kwargs& kw) {
+// {label: Mesh}: by default cut from one pressed shared surface (touching
+// labels share their interface vertex for vertex); separate=True, or a
+// baseline method, meshes each label alone. interfaces=True also returns
+// the shared surface, each interface once, with its label pairs.
+py::object py_press_labels(const py::object& array_like, const py::object& labels, const py::object& spacing,
+                           const py::object& origin, const py::object& direction, const std::string& method,
+                           const std::string& axes, bool separate, bool interfaces, const py::kwargs& kw) {
   SurfaceOptions o;
   o.method = parse_method(method);
   set_options(o, kw);
+  const bool shared = !separate && o.method == Method::pressing;
+  if (shared)
+    for (const char* k : {"flats", "sharpen", "disable_passes", "min_flat_area", "junction_angle", "sharp_angle",
+                          "color_regions", "fit_rings"})
+      if (kw.contains(k))
+        throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface has no flats yet)");
+  if (interfaces && !shared) throw UsageError("interfaces=True needs the shared surface (method='pressing', separate=False)");
   const py::array array = py::module_::import("numpy").attr("asarray")(array_like);
   const ScalarVolume scalar = to_volume(array, spacing, origin, direction, axes);
   std::vector<double> values;  // empty: every label
@@ -248,29 +259,64 @@ py::dict py_press_labels(const py::object& array_like, const py::object& labels,
     for (const py::handle& h : labels) values.push_back(h.cast<double>());
     if (values.empty()) throw UsageError("labels= selects no label");
   }
-  std::vector<LabelSurface> surfaces;
+  std::vector<LabelInfo> chosen;
+  std::vector<Mesh> meshes;
+  std::vector<size_t> flats;
+  SharedSurface s;
+  SharedPressStats ps;
   {
     py::gil_scoped_release release;
     const LabelTable table = label_table(scalar);
-    surfaces = press_labels(scalar, select_labels(table, values, scalar.source), o);
+    chosen = select_labels(table, values, scalar.source);
+    if (shared && !table.layered) {
+      require_float32_room(scalar.lattice, o, scalar.source);
+      s = extract_shared_surface(scalar);
+      PressOptions po = o.press;
+      o.overrides.apply(po);
+      ps = press_shared(s, po);
+      for (const LabelInfo& l : chosen) {
+        const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
+        meshes.push_back(label_mesh(s, uint32_t(it - s.labels.begin())));
+        flats.push_back(0);
+      }
+    } else {
+      for (LabelSurface& ls : press_labels(scalar, chosen, o)) {
+        meshes.push_back(std::move(ls.result.mesh));
+        flats.push_back(ls.result.flats.flats.size());
+      }
+    }
   }
   py::dict out;
-  for (LabelSurface& s : surfaces) {
+  for (size_t i = 0; i < chosen.size(); ++i) {
     PyMesh m;
-    m.mesh = std::move(s.result.mesh);
-    m.stats["label"] = s.label.value;
-    m.stats["samples"] = s.label.samples;
+    m.mesh = std::move(meshes[i]);
+    m.stats["label"] = chosen[i].value;
+    m.stats["samples"] = chosen[i].samples;
     m.stats["vertices"] = m.mesh.vertex_count();
     m.stats["triangles"] = m.mesh.face_count();
-    m.stats["flats"] = s.result.flats.flats.size();
+    m.stats["flats"] = flats[i];
+    m.stats["shared"] = shared;
     m.stats["keeps_classification"] = keeps_classification(o.method);
-    const double v = s.label.value;
+    const double v = chosen[i].value;
     if (v == std::floor(v) && std::abs(v) < 9e15)
       out[py::int_(int64_t(v))] = std::move(m);
     else
       out[py::float_(v)] = std::move(m);
   }
-  return out;
+  if (!interfaces) return out;
+  PyMesh all;
+  all.mesh = std::move(s.mesh);
+  MeshAttribute in{"label_in", ScalarType::u32, {}}, outside{"label_out", ScalarType::u32, {}};
+  for (const auto& sd : s.sides) {
+    in.values.push_back(double(s.labels[sd[0]]));
+    outside.values.push_back(double(s.labels[sd[1]]));
+  }
+  all.mesh.face_attributes = {std::move(in), std::move(outside)};
+  all.stats["junction_curves"] = ps.junction_curves;
+  all.stats["cubes_pinned"] = ps.cubes_pinned;
+  all.stats["cubes_reset"] = ps.cubes_reset;
+  all.stats["seconds"] = ps.seconds;
+  return py::make_tuple(out, all);
 }
 
 // A volume argument of check/evaluate: a file path, or a mask array on a lattice.
@@ -425,6 +471,16 @@ PYBIND11_MODULE(_voxpress, m) {
         for (size_t i = 0; i < a->values.size(); ++i) r.mutable_at(py::ssize_t(i)) = int32_t(a->values[i]);
         return r;
       }, "per face: flat id, -1 curved (None without flats)")
+      .def_property_readonly("label_pairs", [](const PyMesh& pm) -> py::object {
+        const MeshAttribute* a = pm.mesh.face_attribute("label_in");
+        const MeshAttribute* b = pm.mesh.face_attribute("label_out");
+        if (!a || !b) return py::none();
+        py::array_t<int64_t> r({py::ssize_t(a->values.size()), py::ssize_t(2)});
+        auto w = r.mutable_unchecked<2>();
+        for (size_t i = 0; i < a->values.size(); ++i) w(py::ssize_t(i), 0) = int64_t(a->values[i]), w(py::ssize_t(i), 1) = int64_t(b->values[i]);
+        return r;
+      }, "per face of a shared surface: (inside, outside) labels, the normal pointing from the first to the second "
+         "(None otherwise)")
       .def_property_readonly("sharp_edges", [](const PyMesh& pm) {
         py::array_t<int32_t> a({py::ssize_t(pm.mesh.edges.size()), py::ssize_t(2)});
         auto w = a.mutable_unchecked<2>();
@@ -452,7 +508,9 @@ PYBIND11_MODULE(_voxpress, m) {
   m.def("press_labels", &py_press_labels, py::arg("array"), py::kw_only(), py::arg("labels") = py::none(),
         py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
         py::arg("direction") = py::none(), py::arg("method") = "pressing", py::arg("axes") = "xyz",
-        "Every label's smooth surface: {label: Mesh} (see voxpress/__init__.pyi).");
+        py::arg("separate") = false, py::arg("interfaces") = false,
+        "Every label's smooth surface: {label: Mesh}, or ({label: Mesh}, shared Mesh) with interfaces=True "
+        "(see voxpress/__init__.pyi).");
   m.def("read_volume", [](const std::string& path) {
         ScalarVolume* v = nullptr;
         {

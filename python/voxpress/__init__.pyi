@@ -43,6 +43,9 @@ class Mesh:
     def regions(self) -> Optional[npt.NDArray[np.int32]]:
         """Per face: flat id, -1 for curved faces; None when flats were not searched."""
     @property
+    def label_pairs(self) -> Optional[npt.NDArray[np.int64]]:
+        """Per face of a shared surface (press_labels(interfaces=True)): its (inside, outside) labels; else None."""
+    @property
     def sharp_edges(self) -> npt.NDArray[np.int32]:
         """K x 2 vertex pairs: the sharp feature curves."""
     @property
@@ -101,14 +104,22 @@ def press_labels(
     direction: Optional[npt.ArrayLike] = None,
     method: Method = "pressing",
     axes: Literal["xyz", "zyx"] = "xyz",
+    separate: bool = False,
+    interfaces: bool = False,
     **options: Any,
-) -> dict[float, Mesh]:
+) -> Union[dict[float, Mesh], Tuple[dict[float, Mesh], Mesh]]:
     """Every label of an integer label map (0 = background) at once: {label: Mesh}.
 
     labels=None takes every non-zero value; an absent value raises
     InputError. Each mesh keeps its label's samples inside and all others
-    outside; the labels' surfaces are independent (no shared interfaces
-    yet). The options are press()'s (iterations, flats, sharpen, ...).
+    outside. By default the meshes are cut from one pressed surface shared
+    by all labels: where two labels touch, their meshes hold the same
+    triangles (opposite orientations) at bit-identical positions.
+    interfaces=True also returns that surface, each interface once, with
+    Mesh.label_pairs. separate=True (or a baseline method) meshes each label
+    alone, with press()'s flats and sharpening; touching labels' surfaces
+    may then overlap. Options: press()'s (iterations, tolerance; flats,
+    sharpen, ... with separate=True only).
     """
 
 def read_volume(path: str) -> Tuple[npt.NDArray[Any], Lattice]:

@@ -227,6 +227,24 @@ def test_press_labels_every_label_at_once(tmp_path):
     some = voxpress.press_labels(labels, labels=[9], spacing=(1, 1, 1.5))
     assert list(some) == [9]
     np.testing.assert_array_equal(some[9].vertices, meshes[9].vertices)
+    # Shared interfaces: each triangle of the combined surface is in its two
+    # labels' meshes (the background has none), at the same positions.
+    meshes2, shared = voxpress.press_labels(labels, spacing=(1, 1, 1.5), interfaces=True)
+    pairs = shared.label_pairs
+    assert pairs.shape == (len(shared.faces), 2) and set(np.unique(pairs)) == {0, 4, 9, 700}
+    def triangles(mesh, rows, flip=False):
+        tri = mesh.vertices[mesh.faces[rows]]
+        if flip:
+            tri = tri[:, ::-1]
+        return sorted(tuple(np.roll(t, -int(np.lexsort(t.T[::-1])[0]), axis=0).ravel()) for t in tri)
+    for value, mesh in meshes2.items():
+        assert mesh.stats["shared"]
+        want = triangles(shared, pairs[:, 0] == value) + triangles(shared, pairs[:, 1] == value, flip=True)
+        assert triangles(mesh, np.arange(len(mesh.faces))) == sorted(want), value
+    alone = voxpress.press_labels(labels, spacing=(1, 1, 1.5), separate=True)
+    assert not alone[9].stats["shared"] and alone[9].stats["flats"] >= 0
+    with pytest.raises(voxpress.UsageError, match="separate"):
+        voxpress.press_labels(labels, flats=False)
     with pytest.raises(voxpress.InputError, match="label 5"):
         voxpress.press_labels(labels, labels=[4, 5])
     with pytest.raises(voxpress.InputError):
