@@ -3,10 +3,12 @@
 // closed mesh per label, plus FOLDER/labels.json (value, name, file, counts,
 // the labels each one touches). By default the meshes are cut from one
 // pressed shared surface (labels/shared_press.h; FOLDER/interfaces.ply holds
-// it, each interface once); --separate, a layered .seg.nrrd or a baseline
+// it, each interface once; with --format glb|gltf, FOLDER/all_labels.glb
+// holds every label as a coloured node); --separate, a layered .seg.nrrd or a baseline
 // method meshes each label alone. Nothing is written unless every label
 // succeeds (and passes --check).
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -31,6 +33,16 @@ std::string file_stem(const std::string& name) {
   for (unsigned char ch : name) out += (std::isalnum(ch) || ch == '-' || ch == '_' || ch == '.') ? char(ch) : '_';
   while (!out.empty() && out.front() == '.') out.erase(out.begin());
   return out;
+}
+
+// A label's colour in the scene: hues spread by the golden ratio of its
+// value (neighbouring values far apart), fixed saturation and value.
+std::array<double, 4> label_color(double value) {
+  const double h = std::fmod(std::abs(value) * 0.6180339887498949, 1.0) * 6, s = 0.55, v = 0.9;
+  const int i = int(h) % 6;
+  const double f = h - std::floor(h), p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  const double rgb[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
+  return {rgb[i][0], rgb[i][1], rgb[i][2], 1.0};
 }
 
 }  // namespace
@@ -170,6 +182,14 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
     manifest["interfaces"] = {{"file", "interfaces.ply"},
                               {"vertices", combined.vertex_count()},
                               {"triangles", combined.face_count()}};
+  }
+  if (o.format == "glb" || o.format == "gltf") {
+    // Every label in one scene, a node each with its colour, for viewers.
+    std::vector<SceneMesh> scene;
+    for (size_t i = 0; i < pieces.size(); ++i)
+      scene.push_back({fs::path(files[i]).stem().string(), &pieces[i].mesh, label_color(pieces[i].label.value)});
+    write_scene((fs::path(o.folder) / ("all_labels." + o.format)).string(), scene);
+    manifest["scene"] = "all_labels." + o.format;
   }
   write_json((fs::path(o.folder) / "labels.json").string(), manifest);
   size_t vertices = 0, triangles = 0;

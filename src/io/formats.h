@@ -72,5 +72,6 @@ Mesh read_off(const std::string& path, uint64_t max_bytes);
 void write_off(const std::string& path, const Mesh& m);
 Mesh read_gltf(const std::string& path, uint64_t max_bytes, bool binary);
 void write_gltf(const std::string& path, const Mesh& m, bool binary);
+void write_gltf_scene(const std::string& path, const std::vector<SceneMesh>& meshes, bool binary);
 
 }  // namespace voxpress::detail

@@ -30,6 +30,12 @@ void write_mesh(const std::string& path, const Mesh& mesh, const MeshWriteOption
   }
 }
 
+void write_scene(const std::string& path, const std::vector<SceneMesh>& meshes) {
+  const MeshFormat f = mesh_format_from_path(path);
+  if (f != MeshFormat::glb && f != MeshFormat::gltf) throw UsageError(path + ": a scene of several meshes is .glb or .gltf");
+  detail::write_gltf_scene(path, meshes, f == MeshFormat::glb);
+}
+
 Mesh read_mesh(const std::string& path, const MeshReadOptions& options) {
   const uint64_t cap = options.max_bytes ? options.max_bytes : default_memory_limit();
   const MeshFormat f = mesh_format_from_path(path);

@@ -297,15 +297,17 @@ Mesh read_gltf(const std::string& path, uint64_t max_bytes, bool binary) {
   return m;
 }
 
-void write_gltf(const std::string& path, const Mesh& m, bool binary) {
-  m.validate(path);
-  if (m.triangles.empty()) throw UsageError(path + ": glTF output needs at least one triangle");
+void write_gltf_scene(const std::string& path, const std::vector<SceneMesh>& meshes, bool binary) {
+  if (meshes.empty()) throw UsageError(path + ": a glTF scene needs at least one mesh");
+  for (const SceneMesh& e : meshes) {
+    e.mesh->validate(path);
+    if (e.mesh->triangles.empty()) throw UsageError(path + ": glTF output needs at least one triangle (" + e.name + ")");
+  }
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "voxpress";
   tinygltf::Buffer buffer;
-  tinygltf::Primitive prim;
-  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  tinygltf::Scene scene;
   auto add_view = [&](const void* data, size_t bytes, int target) {
     while (buffer.data.size() % 4) buffer.data.push_back(0);
     tinygltf::BufferView view;
@@ -328,6 +330,10 @@ void write_gltf(const std::string& path, const Mesh& m, bool binary) {
     model.accessors.push_back(a);
     return int(model.accessors.size() - 1);
   };
+  for (const SceneMesh& e : meshes) {
+  const Mesh& m = *e.mesh;
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
   // Positions (float32, with the bounds the specification requires).
   std::vector<float> pos(3 * m.positions.size());
   std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
@@ -369,8 +375,8 @@ void write_gltf(const std::string& path, const Mesh& m, bool binary) {
   prim.indices = add_accessor(add_view(m.triangles.data(), m.triangles.size() * 12, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, m.triangles.size() * 3, TINYGLTF_TYPE_SCALAR);
   tinygltf::Material mat;
-  mat.name = "voxpress";
-  mat.pbrMetallicRoughness.baseColorFactor = {0.8, 0.8, 0.8, 1.0};
+  mat.name = e.name;
+  mat.pbrMetallicRoughness.baseColorFactor = {e.color[0], e.color[1], e.color[2], e.color[3]};
   mat.pbrMetallicRoughness.metallicFactor = 0.0;
   mat.pbrMetallicRoughness.roughnessFactor = 0.8;
   mat.doubleSided = false;
@@ -396,24 +402,25 @@ void write_gltf(const std::string& path, const Mesh& m, bool binary) {
     sampler.wrapS = sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
     model.samplers.push_back(sampler);
     tinygltf::Texture texture;
-    texture.source = 0;
-    texture.sampler = 0;
+    texture.source = int(model.images.size() - 1);
+    texture.sampler = int(model.samplers.size() - 1);
     model.textures.push_back(texture);
     mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
-    mat.pbrMetallicRoughness.baseColorTexture.index = 0;
+    mat.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size() - 1);
     mat.pbrMetallicRoughness.roughnessFactor = 1.0;
   }
   model.materials.push_back(mat);
-  prim.material = 0;
+  prim.material = int(model.materials.size() - 1);
   tinygltf::Mesh mesh;
-  mesh.name = "voxpress";
+  mesh.name = e.name;
   mesh.primitives.push_back(prim);
   model.meshes.push_back(mesh);
   tinygltf::Node node;
-  node.mesh = 0;
+  node.mesh = int(model.meshes.size() - 1);
+  if (meshes.size() > 1) node.name = e.name;
   model.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes.push_back(0);
+  scene.nodes.push_back(int(model.nodes.size() - 1));
+  }
   model.scenes.push_back(scene);
   model.defaultScene = 0;
   model.buffers.push_back(std::move(buffer));
@@ -421,6 +428,10 @@ void write_gltf(const std::string& path, const Mesh& m, bool binary) {
     tinygltf::TinyGLTF writer;
     if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary)) throw InputError(path, "glTF writer failed");
   });
+}
+
+void write_gltf(const std::string& path, const Mesh& m, bool binary) {
+  write_gltf_scene(path, {{"voxpress", &m, {0.8, 0.8, 0.8, 1.0}}}, binary);
 }
 
 }  // namespace voxpress::detail

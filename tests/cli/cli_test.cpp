@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
@@ -493,6 +494,24 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
   ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 300,7 --format stl -o " + tmp.path("two"), &out), 0)
       << out;
   EXPECT_EQ(fs::exists(tmp.path("two/label_300.stl")) + fs::exists(tmp.path("two/label_7.stl")), 2);
+  // --format glb: also one scene, a named node per label.
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --format glb -o " + tmp.path("glbs"), &out), 0)
+      << out;
+  {
+    const std::string glb = test::read_file(tmp.path("glbs/all_labels.glb"));
+    ASSERT_GT(glb.size(), 20u);
+    uint32_t json_bytes = 0;
+    std::memcpy(&json_bytes, glb.data() + 12, 4);
+    const nlohmann::json gj = nlohmann::json::parse(glb.substr(20, json_bytes));
+    ASSERT_EQ(gj["nodes"].size(), 3u);
+    std::set<std::string> names;
+    for (const auto& node : gj["nodes"]) names.insert(node["name"].get<std::string>());
+    EXPECT_EQ(names, (std::set<std::string>{"label_7", "label_300", "label_12"}));
+    size_t triangles = 0;
+    for (const char* f : {"glbs/label_7.glb", "glbs/label_300.glb", "glbs/label_12.glb"})
+      triangles += read_mesh(tmp.path(f)).triangles.size();
+    EXPECT_EQ(read_mesh(tmp.path("glbs/all_labels.glb")).triangles.size(), triangles);
+  }
   EXPECT_FALSE(fs::exists(tmp.path("two/label_12.stl")));
   ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 7,7 -o " + tmp.path("once"), &out), 0) << out;
   EXPECT_EQ(nlohmann::json::parse(test::read_file(tmp.path("once/labels.json")))["labels"].size(), 1u);

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # ctest wrapper: writes GLB and glTF files with the CLI (volumes and voxel
-# art, with embedded textures) and validates them.
+# art, with embedded textures; a label map's scene of organs) and validates them.
 # Exit 77 (skipped) only when node or the validator package is unavailable.
 set -euo pipefail
 cli=$1; here=$(cd "$(dirname "$0")" && pwd)
@@ -22,6 +22,9 @@ if [ -d "$shared/vox" ]; then
   "$cli" -q voxart "$shared/vox/chr_knight.vox" -o "$work/knight.glb"
   "$cli" -q voxart "$shared/vxl/hmec.vxl" -o "$work/hmec.glb" --faces 4000
   files+=("$work/knight.glb" "$work/hmec.glb")
+  # A label map's organs as one scene, a coloured node per label.
+  "$cli" -q press "$shared/medical/totalseg_example_seg_fast_force_split.nii.gz" --labels 1,2,3,5 --format glb -o "$work/organs"
+  files+=("$work/organs/all_labels.glb")
 else
   echo "../shared/data is absent: shared voxel art not validated"
 fi
