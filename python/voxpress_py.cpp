@@ -305,13 +305,7 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
   }
   if (!interfaces) return out;
   PyMesh all;
-  all.mesh = std::move(s.mesh);
-  MeshAttribute in{"label_in", ScalarType::u32, {}}, outside{"label_out", ScalarType::u32, {}};
-  for (const auto& sd : s.sides) {
-    in.values.push_back(double(s.labels[sd[0]]));
-    outside.values.push_back(double(s.labels[sd[1]]));
-  }
-  all.mesh.face_attributes = {std::move(in), std::move(outside)};
+  all.mesh = interfaces_mesh(s);
   all.stats["junction_curves"] = ps.junction_curves;
   all.stats["cubes_pinned"] = ps.cubes_pinned;
   all.stats["cubes_reset"] = ps.cubes_reset;

@@ -32,13 +32,7 @@ void run_extract_labels(const ExtractCmd& c, const Global& g) {
       j["label"] = s.labels[L];
       checks.push_back(j);
     }
-  Mesh mesh = s.mesh;
-  MeshAttribute in{"label_in", ScalarType::u32, {}}, out{"label_out", ScalarType::u32, {}};
-  for (const auto& sd : s.sides) {
-    in.values.push_back(double(s.labels[sd[0]]));
-    out.values.push_back(double(s.labels[sd[1]]));
-  }
-  mesh.face_attributes = {std::move(in), std::move(out)};
+  const Mesh mesh = interfaces_mesh(s);
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
   write_mesh(c.output, mesh, wo);

@@ -96,13 +96,7 @@ std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vec
     const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
     out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), 0});
   }
-  combined = s.mesh;
-  MeshAttribute in{"label_in", ScalarType::u32, {}}, outside{"label_out", ScalarType::u32, {}};
-  for (const auto& sd : s.sides) {
-    in.values.push_back(double(s.labels[sd[0]]));
-    outside.values.push_back(double(s.labels[sd[1]]));
-  }
-  combined.face_attributes = {std::move(in), std::move(outside)};
+  combined = interfaces_mesh(s);
   return out;
 }
 

@@ -219,4 +219,17 @@ Mesh label_mesh(const SharedSurface& s, uint32_t label) {
   return m;
 }
 
+Mesh interfaces_mesh(const SharedSurface& s) {
+  Mesh m = s.mesh;
+  MeshAttribute in{"label_in", ScalarType::u32, {}}, out{"label_out", ScalarType::u32, {}};
+  in.values.reserve(s.sides.size());
+  out.values.reserve(s.sides.size());
+  for (const auto& sd : s.sides) {
+    in.values.push_back(double(s.labels[sd[0]]));
+    out.values.push_back(double(s.labels[sd[1]]));
+  }
+  m.face_attributes = {std::move(in), std::move(out)};
+  return m;
+}
+
 }  // namespace voxpress

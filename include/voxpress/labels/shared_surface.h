@@ -49,4 +49,8 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume);
 /// shared mesh. Vertex positions are bit-identical to the shared mesh's.
 Mesh label_mesh(const SharedSurface& surface, uint32_t label);
 
+/// The whole shared surface, each interface once, with face attributes
+/// label_in and label_out (the label values on either side; PLY keeps them).
+Mesh interfaces_mesh(const SharedSurface& surface);
+
 }  // namespace voxpress
