@@ -28,6 +28,7 @@ voxpress_require(HDF5 libhdf5-dev COMPONENTS C)
 voxpress_require(TinyGLTF libtinygltf-dev)
 voxpress_require(tinyobjloader libtinyobjloader-dev)
 voxpress_require(nlohmann_json nlohmann-json3-dev)
+voxpress_require(pugixml libpugixml-dev)
 
 voxpress_require(CLI11 libcli11-dev)
 voxpress_require(meshoptimizer libmeshoptimizer-dev CONFIG)

@@ -13,7 +13,7 @@ with_tests=0
 
 packages=(build-essential cmake ninja-build pkg-config
           libeigen3-dev libtbb-dev zlib1g-dev libtiff-dev libpng-dev libnifti2-dev
-          libhdf5-dev libtinygltf-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
+          libhdf5-dev libpugixml-dev libtinygltf-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
           libgtest-dev libgmock-dev libbenchmark-dev libmeshoptimizer-dev nodejs
           python3-dev pybind11-dev python3-numpy)
 [ $with_tests = 1 ] && packages+=(python3-pytest python3-nibabel python3-dask python3-distributed python3-zarr chromium

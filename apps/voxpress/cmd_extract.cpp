@@ -35,6 +35,7 @@ void run_extract_labels(const ExtractCmd& c, const Global& g) {
   const Mesh mesh = interfaces_mesh(s);
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
+  wo.space = volume.lattice.space;
   write_mesh(c.output, mesh, wo);
   if (!g.quiet)
     std::fprintf(stderr, "%s: %zu labels, %zu vertices (%llu on face centres, %llu inside cubes), %zu triangles\n",
@@ -68,6 +69,7 @@ void run_extract(const ExtractCmd& c, const Global& g) {
   const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), "extracted") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
+  wo.space = vs.volume.lattice.space;
   write_mesh(c.output, mesh, wo);
   if (!g.quiet)
     std::fprintf(stderr, "%s: %zu vertices, %zu triangles\n", c.output.c_str(), mesh.vertex_count(), mesh.face_count());

@@ -251,6 +251,7 @@ void run_press(const PressCmd& c, const Global& g) {
   const nlohmann::json checks = c.check ? p.check(mesh, strict) : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
+  wo.space = p.lattice.space;
   write_mesh(c.output, mesh, wo);
   if (!c.features.empty()) write_features(c.features, mesh);
   const int iterations = pressing ? r.press.iterations : so.method == Method::cesn ? r.net.iterations : r.smooth.iterations;
@@ -324,11 +325,11 @@ void register_press(CLI::App& app, Global& g) {
                  "FOLDER/labels.json");
   lm->add_option("--label-names", c->label_names, "Label names, one 'VALUE NAME' per line (segment names of a "
                                                   ".seg.nrrd are used without it)");
-  lm->add_option("--format", c->format, "Mesh format of --labels: ply, obj, stl, off, glb, gltf")->capture_default_str();
+  lm->add_option("--format", c->format, "Mesh format of --labels: ply, obj, stl, off, glb, gltf, vtk, vtp")->capture_default_str();
   lm->add_flag("--separate", c->separate,
                "Mesh each label alone, with its own flats and sharpening (touching labels' surfaces are then not "
                "shared: they may overlap near their common wall); default: one shared surface, pressed, plus "
-               "FOLDER/interfaces.ply");
+               "FOLDER/interfaces.ply (.vtk / .vtp with that --format)");
   cmd->add_option("--method", c->method,
                   "Smoothing method: pressing, cesn, diamond, cell-edge, cell-size, taubin or laplacian (all but "
                   "pressing are baselines; docs/ARCHITECTURE.md)")

@@ -2,8 +2,8 @@
 // label map (or every segment of a .seg.nrrd) pressed in one process, one
 // closed mesh per label, plus FOLDER/labels.json (value, name, file, counts,
 // the labels each one touches). By default the meshes are cut from one
-// pressed shared surface (labels/shared_press.h; FOLDER/interfaces.ply holds
-// it, each interface once; with --format glb|gltf, FOLDER/all_labels.glb
+// pressed shared surface (labels/shared_press.h; FOLDER/interfaces.ply, .vtk
+// or .vtp holds it, each interface once; with --format glb|gltf, FOLDER/all_labels.glb
 // holds every label as a coloured node); --separate, a layered .seg.nrrd or a baseline
 // method meshes each label alone. Nothing is written unless every label
 // succeeds (and passes --check).
@@ -49,8 +49,9 @@ std::array<double, 4> label_color(double value) {
 
 void check_label_output(const LabelOutput& o) {
   namespace fs = std::filesystem;
-  static const std::set<std::string> formats = {"ply", "obj", "stl", "off", "glb", "gltf"};
-  if (!formats.count(o.format)) throw UsageError("--format must be one of ply, obj, stl, off, glb, gltf, not '" + o.format + "'");
+  static const std::set<std::string> formats = {"ply", "obj", "stl", "off", "glb", "gltf", "vtk", "vtp"};
+  if (!formats.count(o.format))
+    throw UsageError("--format must be one of ply, obj, stl, off, glb, gltf, vtk, vtp, not '" + o.format + "'");
   std::error_code ec;
   if (fs::exists(o.folder, ec) && !fs::is_directory(o.folder, ec))
     throw UsageError(o.folder + ": with --labels, -o names a folder (one mesh per label), and this is a file");
@@ -164,6 +165,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   fs::create_directories(o.folder);
   MeshWriteOptions wo;
   wo.ascii = o.ascii;
+  wo.space = volume.lattice.space;
   for (size_t i = 0; i < pieces.size(); ++i) write_mesh(files[i], pieces[i].mesh, wo);
   nlohmann::json manifest = {{"input", input},
                              {"layered", table.layered},
@@ -171,9 +173,11 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
                              {"lattice", lattice_json(volume.lattice)},
                              {"labels", list}};
   if (shared) {
-    // The whole surface, each interface once, its two labels as face attributes.
-    write_mesh((fs::path(o.folder) / "interfaces.ply").string(), combined, wo);
-    manifest["interfaces"] = {{"file", "interfaces.ply"},
+    // The whole surface, each interface once, its two labels as face
+    // attributes: in the chosen format where it keeps them (PLY, VTK, VTP).
+    const std::string name = "interfaces." + (o.format == "vtk" || o.format == "vtp" ? o.format : std::string("ply"));
+    write_mesh((fs::path(o.folder) / name).string(), combined, wo);
+    manifest["interfaces"] = {{"file", name},
                               {"vertices", combined.vertex_count()},
                               {"triangles", combined.face_count()}};
   }
@@ -194,7 +198,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   if (!g.quiet)
     std::fprintf(stderr, "%s: %zu labels%s, %zu vertices, %zu triangles%s, %.2f s\n", o.folder.c_str(), pieces.size(),
                  table.layered ? " (layered segmentation: each segment meshed on its own layer)" : "", vertices,
-                 triangles, shared ? " (interfaces shared: interfaces.ply holds each once)" : "", clock.seconds());
+                 triangles, shared ? " (interfaces shared: interfaces file holds each once)" : "", clock.seconds());
   if (!o.stats_json.empty()) {
     nlohmann::json j = manifest;
     j["command"] = "press --labels";

@@ -311,7 +311,8 @@ void check_paths(const std::vector<std::string>& inputs,
     const char* expected = nullptr;
     switch (kind) {
       case OutputKind::mesh:
-        if (!known({".ply", ".obj", ".stl", ".off", ".glb", ".gltf"})) expected = ".ply .obj .stl .off .glb .gltf";
+        if (!known({".ply", ".obj", ".stl", ".off", ".glb", ".gltf", ".vtk", ".vtp"}))
+          expected = ".ply .obj .stl .off .glb .gltf .vtk .vtp";
         break;
       case OutputKind::volume:
         if (!known({".nrrd", ".seg.nrrd", ".nii", ".nii.gz", ".mha", ".tif", ".tiff", ".h5", ".hdf5"}))

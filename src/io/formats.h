@@ -63,15 +63,19 @@ void write_hdf5(const std::string& path, const ScalarVolume& v, bool compress);
 ScalarVolume read_raw(const std::string& path, const RawLayout& layout, uint64_t max_bytes, RawPayload* raw = nullptr);
 
 Mesh read_ply(const std::string& path, uint64_t max_bytes);
-void write_ply(const std::string& path, const Mesh& m, bool binary);
+void write_ply(const std::string& path, const Mesh& m, bool binary, Space space = Space::unknown);
 Mesh read_obj(const std::string& path, uint64_t max_bytes);
 void write_obj(const std::string& path, const Mesh& m);
 Mesh read_stl(const std::string& path, uint64_t max_bytes);
-void write_stl(const std::string& path, const Mesh& m);
+void write_stl(const std::string& path, const Mesh& m, Space space = Space::unknown);
 Mesh read_off(const std::string& path, uint64_t max_bytes);
 void write_off(const std::string& path, const Mesh& m);
 Mesh read_gltf(const std::string& path, uint64_t max_bytes, bool binary);
 void write_gltf(const std::string& path, const Mesh& m, bool binary);
+Mesh read_vtk(const std::string& path, uint64_t max_bytes);
+void write_vtk(const std::string& path, const Mesh& m, bool binary, Space space);
+Mesh read_vtp(const std::string& path, uint64_t max_bytes);
+void write_vtp(const std::string& path, const Mesh& m, Space space);
 void write_gltf_scene(const std::string& path, const std::vector<SceneMesh>& meshes, bool binary);
 
 }  // namespace voxpress::detail

@@ -191,6 +191,13 @@ std::string format_double(double x) {
   return std::string(tmp, r.ptr);
 }
 
+std::string format_typed(ScalarType t, double x) {
+  if (t == ScalarType::f32) return format_double(double(float(x)));
+  if (t == ScalarType::f64) return format_double(x);
+  if (t == ScalarType::u64) return std::to_string(uint64_t(x));
+  return std::to_string(int64_t(x));
+}
+
 double parse_double(const std::string& path, const std::string& text, const std::string& what) {
   const std::string t = trim(text);
   double v = 0;

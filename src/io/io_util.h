@@ -54,6 +54,9 @@ uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& di
 
 /// Shortest decimal text that reads back as exactly the same double.
 std::string format_double(double x);
+/// A value of type t as text: floats as format_double (f32 rounded first),
+/// integers in full ("100000", never "1e+05", which other readers refuse).
+std::string format_typed(ScalarType t, double x);
 
 /// Parses a floating-point number; throws InputError(path, what + ...) otherwise.
 double parse_double(const std::string& path, const std::string& text, const std::string& what);

@@ -16,17 +16,21 @@ MeshFormat mesh_format_from_path(const std::string& path) {
   if (ext == ".off") return MeshFormat::off;
   if (ext == ".gltf") return MeshFormat::gltf;
   if (ext == ".glb") return MeshFormat::glb;
-  throw InputError(path, "unknown mesh format '" + ext + "' (use .ply .obj .stl .off .glb or .gltf)");
+  if (ext == ".vtk") return MeshFormat::vtk;
+  if (ext == ".vtp") return MeshFormat::vtp;
+  throw InputError(path, "unknown mesh format '" + ext + "' (use .ply .obj .stl .off .glb .gltf .vtk or .vtp)");
 }
 
 void write_mesh(const std::string& path, const Mesh& mesh, const MeshWriteOptions& options) {
   switch (mesh_format_from_path(path)) {
-    case MeshFormat::ply: return detail::write_ply(path, mesh, !options.ascii);
+    case MeshFormat::ply: return detail::write_ply(path, mesh, !options.ascii, options.space);
     case MeshFormat::obj: return detail::write_obj(path, mesh);
-    case MeshFormat::stl: return detail::write_stl(path, mesh);
+    case MeshFormat::stl: return detail::write_stl(path, mesh, options.space);
     case MeshFormat::off: return detail::write_off(path, mesh);
     case MeshFormat::gltf: return detail::write_gltf(path, mesh, false);
     case MeshFormat::glb: return detail::write_gltf(path, mesh, true);
+    case MeshFormat::vtk: return detail::write_vtk(path, mesh, !options.ascii, options.space);
+    case MeshFormat::vtp: return detail::write_vtp(path, mesh, options.space);
   }
 }
 
@@ -47,6 +51,8 @@ Mesh read_mesh(const std::string& path, const MeshReadOptions& options) {
     case MeshFormat::off: return detail::read_off(path, cap);
     case MeshFormat::gltf: return detail::read_gltf(path, cap, false);
     case MeshFormat::glb: return detail::read_gltf(path, cap, true);
+    case MeshFormat::vtk: return detail::read_vtk(path, cap);
+    case MeshFormat::vtp: return detail::read_vtp(path, cap);
   }
   return {};
 }

@@ -344,7 +344,7 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
   return m;
 }
 
-void write_ply(const std::string& path, const Mesh& m, bool binary) {
+void write_ply(const std::string& path, const Mesh& m, bool binary, Space space) {
   m.validate(path);
   if (!m.uvs.empty()) {
     // PLY keeps no texture here: the vertices split at chart seams are
@@ -353,10 +353,11 @@ void write_ply(const std::string& path, const Mesh& m, bool binary) {
     solid.uvs.clear();
     solid.texture = {};
     weld_identical_vertices(solid);
-    return write_ply(path, solid, binary);
+    return write_ply(path, solid, binary, space);
   }
   std::ostringstream h;
   h << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\ncomment written by voxpress\n";
+  if (space != Space::unknown) h << "comment SPACE=" << space_name(space) << "\n";  // read by 3D Slicer
   h << "element vertex " << m.positions.size() << "\nproperty double x\nproperty double y\nproperty double z\n";
   if (!m.normals.empty()) h << "property float nx\nproperty float ny\nproperty float nz\n";
   if (!m.colors.empty()) h << "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
@@ -373,7 +374,7 @@ void write_ply(const std::string& path, const Mesh& m, bool binary) {
     auto put_typed = [&](ScalarType t, double x) {
       if (!binary) {
         if (!buf.empty() && buf.back() != '\n') buf.push_back(' ');
-        buf += format_double(t == ScalarType::f32 ? double(float(x)) : x);
+        buf += format_typed(t, x);
         return;
       }
       switch (t) {

@@ -132,11 +132,12 @@ Mesh read_stl(const std::string& path, uint64_t max_bytes) {
   return m;
 }
 
-void write_stl(const std::string& path, const Mesh& m) {
+void write_stl(const std::string& path, const Mesh& m, Space space) {
   m.validate(path);
   write_stream_atomically(path, [&](std::ostream& out) {
     char header[80] = {};
-    std::snprintf(header, sizeof header, "binary STL written by voxpress");
+    std::snprintf(header, sizeof header, "binary STL written by voxpress%s%s", space == Space::unknown ? "" : ". SPACE=",
+                  space == Space::unknown ? "" : space_name(space));  // read by 3D Slicer
     out.write(header, 80);
     const uint32_t n = uint32_t(m.triangles.size());
     out.write(reinterpret_cast<const char*>(&n), 4);

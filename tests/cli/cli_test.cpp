@@ -52,7 +52,7 @@ TEST(Cli, GenerateInfoExtractCheckPipeline) {
   const auto info = nlohmann::json::parse(std::ifstream(tmp.path("info.json")));
   EXPECT_EQ(info["lattice"]["spacing"][2], 1.5);
   EXPECT_GT(info["sticks"].get<uint64_t>(), 0u);
-  for (const std::string fmt : {"ply", "obj", "stl", "off", "glb", "gltf"}) {
+  for (const std::string fmt : {"ply", "obj", "stl", "off", "glb", "gltf", "vtk", "vtp"}) {
     ASSERT_EQ(run_cli("-q extract " + tmp.path("t.nrrd") + " -o " + tmp.path("t." + fmt) + " --stats-json " +
                           tmp.path("s.json"),
                       &out),
@@ -513,6 +513,17 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
     EXPECT_EQ(read_mesh(tmp.path("glbs/all_labels.glb")).triangles.size(), triangles);
   }
   EXPECT_FALSE(fs::exists(tmp.path("two/label_12.stl")));
+  // --format vtp|vtk: the interfaces in that format too (VTK keeps the face labels).
+  for (const std::string fmt : {"vtp", "vtk"}) {
+    ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --format " + fmt + " -o " + tmp.path(fmt), &out), 0)
+        << out;
+    const Mesh v = read_mesh(tmp.path(fmt + "/interfaces." + fmt));
+    EXPECT_FALSE(fs::exists(tmp.path(fmt + "/interfaces.ply")));
+    EXPECT_EQ(v.positions, all.positions);
+    EXPECT_EQ(v.triangles, all.triangles);
+    ASSERT_EQ(v.face_attributes.size(), 2u);
+    for (size_t a = 0; a < 2; ++a) EXPECT_EQ(v.face_attributes[a].values, all.face_attributes[a].values);
+  }
   ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 7,7 -o " + tmp.path("once"), &out), 0) << out;
   EXPECT_EQ(nlohmann::json::parse(test::read_file(tmp.path("once/labels.json")))["labels"].size(), 1u);
   // Refused before any output: absent label, -o a file, bad table, bad format, --label with --labels.

@@ -1,6 +1,6 @@
 // What the user gets is what is checked: the default press written in every
 // mesh format and read back keeps every guarantee in that format's precision
-// (STL and glTF store float32; PLY, OBJ and OFF the exact doubles).
+// (STL and glTF store float32; PLY, OBJ, OFF, VTK and VTP the exact doubles).
 #include "test_util.h"
 
 namespace voxpress {
@@ -10,7 +10,7 @@ void expect_every_format_keeps_the_guarantee(const BinaryVolume& volume, const s
   const SurfaceResult r = smooth_surface(volume);
   ASSERT_GT(r.sharpen.inserted, 0u) << "the case exercises the sharpening";
   test::TempDir dir;
-  for (const char* ext : {".ply", ".obj", ".off", ".stl", ".glb", ".gltf"}) {
+  for (const char* ext : {".ply", ".obj", ".off", ".stl", ".glb", ".gltf", ".vtk", ".vtp"}) {
     SCOPED_TRACE(name + ext);
     const std::string path = dir.path("out" + std::string(ext));
     write_mesh(path, r.mesh);

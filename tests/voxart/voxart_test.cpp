@@ -456,7 +456,7 @@ TEST(Voxart, EveryWrittenFormatIsTheClosedSolid) {
   EXPECT_GT(weld_identical_vertices(split), 0u) << "the textured mesh has seams";
   EXPECT_FALSE(check_mesh(r.mesh).closed()) << "as split, it is not the solid";
   test::TempDir dir;
-  for (const std::string ext : {".ply", ".off", ".obj", ".stl", ".glb", ".gltf"}) {
+  for (const std::string ext : {".ply", ".off", ".obj", ".stl", ".glb", ".gltf", ".vtk", ".vtp"}) {
     SCOPED_TRACE(ext);
     write_mesh(dir.path("m" + ext), r.mesh);
     const Mesh back = read_mesh(dir.path("m" + ext));
