@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
@@ -247,10 +248,9 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
   set_options(o, kw);
   const bool shared = !separate && o.method == Method::pressing;
   if (shared)
-    for (const char* k : {"flats", "sharpen", "disable_passes", "min_flat_area", "junction_angle", "sharp_angle",
-                          "color_regions", "fit_rings"})
+    for (const char* k : {"sharpen", "sharp_angle", "color_regions", "fit_rings"})
       if (kw.contains(k))
-        throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface has no flats yet)");
+        throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface is not sharpened)");
   if (interfaces && !shared) throw UsageError("interfaces=True needs the shared surface (method='pressing', separate=False)");
   const py::array array = py::module_::import("numpy").attr("asarray")(array_like);
   const ScalarVolume scalar = to_volume(array, spacing, origin, direction, axes);
@@ -264,6 +264,7 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
   std::vector<size_t> flats;
   SharedSurface s;
   SharedPressStats ps;
+  size_t shared_flats = 0;
   {
     py::gil_scoped_release release;
     const LabelTable table = label_table(scalar);
@@ -273,12 +274,19 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
       s = extract_shared_surface(scalar);
       PressOptions po = o.press;
       o.overrides.apply(po);
-      ps = press_shared(s, po);
+      std::optional<SharedFlats> sf;
+      if (o.passes.on(Pass::flats)) {
+        FlatOptions fo = o.flat;
+        fo.passes = o.passes;
+        sf = find_shared_flats(scalar, s, po, fo);
+      }
+      ps = press_shared(s, po, sf ? &*sf : nullptr);
       for (const LabelInfo& l : chosen) {
         const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
         meshes.push_back(label_mesh(s, uint32_t(it - s.labels.begin())));
-        flats.push_back(0);
+        flats.push_back(sf ? size_t(std::count(sf->flat_label.begin(), sf->flat_label.end(), uint32_t(l.value))) : 0);
       }
+      shared_flats = sf ? sf->flats.size() : 0;
     } else {
       for (LabelSurface& ls : press_labels(scalar, chosen, o)) {
         meshes.push_back(std::move(ls.result.mesh));
@@ -309,6 +317,8 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
   all.stats["junction_curves"] = ps.junction_curves;
   all.stats["cubes_pinned"] = ps.cubes_pinned;
   all.stats["cubes_reset"] = ps.cubes_reset;
+  all.stats["flats"] = shared_flats;
+  all.stats["flat_vertices"] = ps.flat_vertices;
   all.stats["seconds"] = ps.seconds;
   return py::make_tuple(out, all);
 }

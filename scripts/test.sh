@@ -10,29 +10,20 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 phase() { echo "== $1 at $((SECONDS / 60)) min $((SECONDS % 60)) s" >&2; }
 "$root/scripts/setup.sh" --tests
 phase "setup and Release build done"
-sanitize=1; [ "${VOXPRESS_NO_SANITIZE:-0}" = 1 ] && sanitize=0
-# The sanitized build (below) starts beside the Release suite: the suite's
-# tail and the build's links leave a core idle, which the other fills.
-if [ $sanitize = 1 ]; then
-  # clang when present (setup installs it): it compiles the sanitized library
-  # in half gcc's time.
-  compilers=(); command -v clang++ >/dev/null 2>&1 && compilers=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang)
-  suites=(core_tests extract_tests io_tests eval_tests smooth_tests voxart_tests render_tests)
-  ( cmake -S "$root" -B "$root/build-asan" -G Ninja "${compilers[@]}" -DCMAKE_BUILD_TYPE=Sanitize \
-      -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g0" -DCMAKE_C_FLAGS_SANITIZE="-O1 -g0" -DVOXPRESS_SANITIZE=ON \
-      -DVOXPRESS_PYTHON=OFF -DVOXPRESS_BUILD_BENCH=OFF >/dev/null &&
-    cmake --build "$root/build-asan" -j "$(nproc)" --target "${suites[@]}" ) > "$root/build/sanitized-build.log" 2>&1 &
-  asan_build=$!
-fi
 cd "$root/build"
-suite=0
-ctest --output-on-failure -j "$(nproc)" || suite=$?
+ctest --output-on-failure -j "$(nproc)"
 phase "Release suite done"
-if [ $sanitize = 0 ]; then exit $suite; fi
-if [ $suite != 0 ]; then kill -- "$asan_build" 2>/dev/null || true; exit $suite; fi
-wait $asan_build || { tail -40 "$root/build/sanitized-build.log"; echo "sanitized build FAILED" >&2; exit 1; }
-phase "sanitized build done"
+[ "${VOXPRESS_NO_SANITIZE:-0}" = 1 ] && exit 0
+
 echo "== the unit and property tests under ASan + UBSan" >&2
+suites=(core_tests extract_tests io_tests eval_tests smooth_tests voxart_tests render_tests)
+# clang when present (setup installs it): it compiles the sanitized library
+# in half gcc's time.
+compilers=(); command -v clang++ >/dev/null 2>&1 && compilers=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang)
+cmake -S "$root" -B "$root/build-asan" -G Ninja "${compilers[@]}" -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g0" \
+  -DCMAKE_C_FLAGS_SANITIZE="-O1 -g0" -DVOXPRESS_SANITIZE=ON -DVOXPRESS_PYTHON=OFF -DVOXPRESS_BUILD_BENCH=OFF >/dev/null
+cmake --build "$root/build-asan" -j "$(nproc)" --target "${suites[@]}" >&2
+phase "sanitized build done"
 # Each suite's executable directly (the CLI, Python and browser tests ran in
 # Release above), two at a time; any sanitizer report fails the suite. Left
 # out (all passed in Release above): the fidelity checks at 64-128^3 (10-160 s

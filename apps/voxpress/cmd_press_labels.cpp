@@ -12,6 +12,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <unistd.h>
 
@@ -83,7 +84,14 @@ std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vec
   Stopwatch clock;
   SharedSurface s = extract_shared_surface(volume);
   const double t_extract = clock.seconds();
-  const SharedPressStats ps = press_shared(s, so.press);
+  // Flats per label (shared_flats.h), unless --no-flats.
+  std::optional<SharedFlats> flats;
+  if (so.passes.on(Pass::flats)) {
+    FlatOptions fo = so.flat;
+    fo.passes = so.passes;
+    flats = find_shared_flats(volume, s, so.press, fo, so.progress);
+  }
+  const SharedPressStats ps = press_shared(s, so.press, flats ? &*flats : nullptr);
   stats = {{"vertices", {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}}},
            {"junction_curves", ps.junction_curves},
            {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
@@ -91,11 +99,23 @@ std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vec
            {"iterations", {{"junctions", ps.junctions.iterations}, {"interfaces", ps.interfaces.iterations}}},
            {"cubes_pinned", ps.cubes_pinned},
            {"cubes_reset", ps.cubes_reset},
-           {"seconds", {{"extract", t_extract}, {"press", ps.seconds}}}};
+           {"flats", nlohmann::json::array()},
+           {"flat_vertices", ps.flat_vertices},
+           {"seconds", {{"extract", t_extract}, {"flats", flats ? flats->seconds : 0.0}, {"press", ps.seconds}}}};
+  if (flats)  // each flat: the label it was found on, its plane and area
+    for (size_t i = 0; i < flats->flats.size(); ++i) {
+      const Flat& f = flats->flats[i];
+      stats["flats"].push_back({{"label", flats->flat_label[i]},
+                                {"normal", {f.normal.x(), f.normal.y(), f.normal.z()}},
+                                {"offset", f.offset},
+                                {"area", f.area},
+                                {"sticks", f.sticks}});
+    }
   std::vector<LabelPiece> out;
   for (const LabelInfo& l : chosen) {
     const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
-    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), 0});
+    const size_t own = flats ? size_t(std::count(flats->flat_label.begin(), flats->flat_label.end(), uint32_t(l.value))) : 0;
+    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), own});
   }
   combined = interfaces_mesh(s);
   return out;

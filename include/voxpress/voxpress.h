@@ -22,6 +22,7 @@
 #include "voxpress/smooth/mesh_smoothing.h"
 #include "voxpress/smooth/pipeline.h"
 #include "voxpress/labels/labels.h"
+#include "voxpress/labels/shared_flats.h"
 #include "voxpress/labels/shared_surface.h"
 #include "voxpress/labels/shared_press.h"
 #include "voxpress/chunk/chunked.h"

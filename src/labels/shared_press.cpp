@@ -260,11 +260,13 @@ std::vector<uint32_t> failing(const Mesh& m, const Cubes& c, const std::vector<u
 
 }  // namespace
 
-SharedPressStats press_shared(SharedSurface& s, const PressOptions& o) {
+SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const SharedFlats* flats) {
   const auto t0 = std::chrono::steady_clock::now();
   SharedPressStats st;
   const size_t n = s.mesh.positions.size();
   if (s.kind.size() != n || s.corner.size() != n) throw std::invalid_argument("press_shared: vertex kinds missing");
+  if (flats && (flats->t.size() != n || flats->region.size() != n || flats->barrier.size() != n))
+    throw std::invalid_argument("press_shared: flats of another surface");
   // Index positions of the midpoint surface; t of the stick vertices.
   std::vector<Vec3> x0(n);
   std::vector<double> t0s(n, 0);
@@ -301,8 +303,14 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o) {
     if (jg.degree(v) > 0) members.push_back(v);
 
   // The labelled contours of every plane, cut at the junction points.
-  std::vector<uint8_t> barrier(n, 0);
-  for (uint32_t v = 0; v < n; ++v) barrier[v] = !is_stick(s.kind[v]) || jg.degree(v) > 0;
+  // Stick vertices on a flat keep its plane (junction lines excepted: they
+  // stay at their midpoints); those at a sharp border are barriers too.
+  std::vector<uint8_t> on_flat(n, 0), barrier(n, 0);
+  for (uint32_t v = 0; v < n; ++v) {
+    on_flat[v] = flats && flats->region[v] >= 0 && is_stick(s.kind[v]) && jg.degree(v) == 0;
+    st.flat_vertices += on_flat[v];
+    barrier[v] = !is_stick(s.kind[v]) || jg.degree(v) > 0 || (on_flat[v] && flats->barrier[v]);
+  }
   std::vector<detail::Family> families(3);
   std::vector<uint32_t> ids[3], offsets[3];
   const Mat3 M = s.lattice.index_to_physical_matrix();
@@ -377,7 +385,10 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o) {
         if (!is_stick(s.kind[ids[a][k]])) f.base[k] = Vec2(x[ids[a][k]][u], x[ids[a][k]][w]);
     }
     std::vector<uint8_t> frozen(barrier);
-    for (uint32_t v = 0; v < n; ++v) frozen[v] |= pinned[v];
+    for (uint32_t v = 0; v < n; ++v) {
+      frozen[v] |= pinned[v] | on_flat[v];
+      if (on_flat[v] && !pinned[v]) t[v] = flats->t[v];
+    }
     st.interfaces = detail::iterate(t, families, 2, frozen, barrier, o, levels);
     tbb::parallel_for(size_t(0), n, [&](size_t v) {
       if (!is_stick(s.kind[v]) || jg.degree(v) > 0) return;  // junction sticks stay at x0

@@ -244,7 +244,11 @@ def test_press_labels_every_label_at_once(tmp_path):
     alone = voxpress.press_labels(labels, spacing=(1, 1, 1.5), separate=True)
     assert not alone[9].stats["shared"] and alone[9].stats["flats"] >= 0
     with pytest.raises(voxpress.UsageError, match="separate"):
-        voxpress.press_labels(labels, flats=False)
+        voxpress.press_labels(labels, sharpen=False)
+    # Flats of the shared surface can be turned off: the plain shared press.
+    plain, plain_shared = voxpress.press_labels(labels, spacing=(1, 1, 1.5), flats=False, interfaces=True)
+    assert plain_shared.stats["flats"] == 0 and plain_shared.stats["flat_vertices"] == 0
+    assert all(m.stats["flats"] == 0 for m in plain.values())
     with pytest.raises(voxpress.InputError, match="label 5"):
         voxpress.press_labels(labels, labels=[4, 5])
     with pytest.raises(voxpress.InputError):

@@ -31,6 +31,7 @@
 
 #include <cstddef>
 
+#include "voxpress/labels/shared_flats.h"
 #include "voxpress/labels/shared_surface.h"
 #include "voxpress/smooth/pressing.h"
 
@@ -43,13 +44,17 @@ struct SharedPressStats {
   size_t plane_curves = 0;       ///< pieces of labelled contours and closed contours on the planes
   size_t cubes_pinned = 0;       ///< cubes that failed the exact check and were pressed again pinned
   size_t cubes_reset = 0;        ///< cubes put back at their midpoints after that
+  size_t flat_vertices = 0;      ///< stick vertices frozen on a flat
   PressStats junctions, interfaces;
   double seconds = 0;
 };
 
 /// Presses the shared surface in place (mesh positions). `options` drives
 /// both stages (iterations, step, arc length, margin, levels, momentum,
-/// circle correction, free ends). Deterministic for any thread count.
-SharedPressStats press_shared(SharedSurface& surface, const PressOptions& options = {});
+/// circle correction, free ends). With `flats` (find_shared_flats of this
+/// surface), their vertices are frozen on their planes and those at sharp
+/// borders cut the slice curves. Deterministic for any thread count.
+SharedPressStats press_shared(SharedSurface& surface, const PressOptions& options = {},
+                              const SharedFlats* flats = nullptr);
 
 }  // namespace voxpress

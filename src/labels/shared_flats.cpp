@@ -1,0 +1,109 @@
+// Flats of a shared surface: each label's binary detection mapped onto the
+// shared stick vertices. Theory of operation: include/voxpress/labels/shared_flats.h.
+#include "voxpress/labels/shared_flats.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "core/timing.h"
+#include "voxpress/labels/labels.h"
+
+namespace voxpress {
+namespace {
+
+// A stick's key: its axis and its lower sample's index, each coordinate + 1
+// (samples beyond the lattice are -1), on a grid of the volume's dims + 2.
+struct StickKey {
+  std::array<int64_t, 3> grid;
+  uint64_t operator()(const std::array<int64_t, 3>& lower, int axis) const {
+    return ((uint64_t(lower[2] + 1) * uint64_t(grid[1]) + uint64_t(lower[1] + 1)) * uint64_t(grid[0]) +
+            uint64_t(lower[0] + 1)) * 3 + uint64_t(axis);
+  }
+};
+
+// One label's flats, as (shared vertex, t, barrier, its flat) entries.
+struct LabelFlats {
+  std::vector<Flat> flats;
+  struct Entry {
+    uint32_t vertex;
+    double t;
+    uint8_t barrier;
+    int32_t flat;
+  };
+  std::vector<Entry> entries;
+};
+
+}  // namespace
+
+SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s, const PressOptions& press,
+                              const FlatOptions& options, Progress* progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t n = s.mesh.positions.size();
+  SharedFlats out;
+  out.t.assign(n, std::numeric_limits<double>::quiet_NaN());
+  out.barrier.assign(n, 0);
+  out.region.assign(n, -1);
+  // The shared stick vertices by key, for the labels' lookups.
+  const StickKey key{{volume.lattice.dims[0] + 2, volume.lattice.dims[1] + 2, volume.lattice.dims[2] + 2}};
+  std::vector<std::pair<uint64_t, uint32_t>> sticks;
+  for (uint32_t v = 0; v < n; ++v)
+    if (s.kind[v] < 3) sticks.push_back({key(s.corner[v], s.kind[v]), v});
+  std::sort(sticks.begin(), sticks.end());
+
+  const LabelTable table = label_table(volume);
+  std::vector<LabelFlats> per(table.labels.size());
+  FlatOptions fo = options;
+  fo.progress = nullptr;
+  PressOptions po = press;
+  po.progress = nullptr;
+  if (progress) progress->begin("flats per label", table.labels.size());
+  std::atomic<uint64_t> done{0};
+  tbb::parallel_for(size_t(0), table.labels.size(), [&](size_t i) {
+    const LabelInfo& label = table.labels[i];
+    const BinaryVolume mask = label_mask(volume, label);
+    const std::array<int64_t, 3> lo = {std::max<int64_t>(0, label.lo[0] - 1), std::max<int64_t>(0, label.lo[1] - 1),
+                                       std::max<int64_t>(0, label.lo[2] - 1)};
+    StickSurface surface = extract_sticks(mask);
+    const SliceCurves curves = build_slice_curves(surface);
+    FlatSegmentation seg;
+    press_with_flats(surface, curves, po, &fo, &seg);
+    LabelFlats& lf = per[i];
+    lf.flats = seg.flats;
+    for (size_t k = 0; k < surface.stick_count(); ++k) {
+      if (seg.region[k] < 0) continue;
+      std::array<int64_t, 3> lower = surface.lower_index(k);
+      for (int a = 0; a < 3; ++a) lower[size_t(a)] += lo[size_t(a)];
+      const uint64_t want = key(lower, surface.axis(k));
+      const auto it = std::lower_bound(sticks.begin(), sticks.end(), std::pair<uint64_t, uint32_t>{want, 0});
+      if (it == sticks.end() || it->first != want) continue;  // cannot happen: a label's sticks are shared sticks
+      // surface.t: from the lower sample, as the shared surface (seg.t is from the inside one).
+      lf.entries.push_back({it->second, surface.t[k], seg.barrier[k], seg.region[k]});
+    }
+    if (progress) progress->update(++done);
+  });
+  if (progress) progress->end();
+  // Labels in value order: the first to freeze a vertex gives its t.
+  for (size_t i = 0; i < per.size(); ++i) {
+    const int32_t base = int32_t(out.flats.size());
+    for (const Flat& f : per[i].flats) {
+      out.flats.push_back(f);
+      out.flat_label.push_back(uint32_t(table.labels[i].value));
+    }
+    for (const auto& e : per[i].entries) {
+      out.barrier[e.vertex] |= e.barrier;
+      if (out.region[e.vertex] >= 0) continue;
+      out.region[e.vertex] = base + e.flat;
+      out.t[e.vertex] = e.t;
+      ++out.frozen;
+    }
+  }
+  out.seconds = detail::seconds_since(t0);
+  return out;
+}
+
+}  // namespace voxpress
