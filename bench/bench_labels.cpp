@@ -4,10 +4,11 @@
 // junctions) on an anisotropic lattice, rotated at random per seed, scaled
 // by --scale. Per label: the RMS distance of its vertices to its true
 // boundary for the midpoint surface, the shared press and the binary press
-// of the label's mask alone; for the junction vertices (face centres and
-// apexes), their distance to the true triple lines. Prints Markdown tables
-// (docs/BENCHMARKS.md).
-//   build/bench/bench_labels [--seeds N] [--scale S] [--iterations N]
+// of the label's mask alone (both with flats, without sharpening, as the
+// shared surface has none; --no-flats: both plain); for the junction
+// vertices (face centres and apexes), their distance to the true triple
+// lines. Prints Markdown tables (docs/BENCHMARKS.md).
+//   build/bench/bench_labels [--seeds N] [--scale S] [--iterations N] [--no-flats]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
 #include <random>
 
 #include "voxpress/voxpress.h"
@@ -109,7 +111,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.5, 8.0));
   PressOptions po;
   app.add_option("--iterations", po.iterations, "Pressing iterations (both stages, and the binary press)")->capture_default_str();
+  bool no_flats = false;
+  app.add_flag("--no-flats", no_flats, "Press both without flats");
   CLI11_PARSE(app, argc, argv);
+  const FlatOptions fo;
   const Vec3 spacing(1, 1.2, 1.5);
   const double cell = std::cbrt(spacing.prod());
   std::array<Row, 5> rows{};
@@ -141,7 +146,9 @@ int main(int argc, char** argv) {
     const SharedSurface mid = extract_shared_surface(v);
     SharedSurface s = mid;
     double t0 = now();
-    const SharedPressStats st = press_shared(s, po);
+    std::optional<SharedFlats> sf;
+    if (!no_flats) sf = find_shared_flats(v, s, po, fo);
+    const SharedPressStats st = press_shared(s, po, sf ? &*sf : nullptr);
     t_shared += now() - t0;
     for (uint32_t L = 1; L < s.labels.size(); ++L) {
       const int value = int(s.labels[L]);
@@ -159,7 +166,7 @@ int main(int argc, char** argv) {
       sel.value = value;
       t0 = now();
       StickSurface b = extract_sticks(binarize(v, sel));
-      press(b, po);
+      press_with_flats(b, build_slice_curves(b), po, no_flats ? nullptr : &fo);
       t_binary += now() - t0;
       const Mesh bm = to_mesh(b);
       r.binary += rms(bm) * double(pm.positions.size()) / double(bm.positions.size());
@@ -207,9 +214,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "seed %d: %zu junction curves, %zu cubes pinned, %zu reset\n", seed, st.junction_curves,
                  st.cubes_pinned, st.cubes_reset);
   }
-  std::printf("Label phantom, scale %.2f, spacing 1 x 1.2 x 1.5, %d random rotations: vertex RMS to each label's "
-              "true boundary (voxels)\n\n",
-              scale, seeds);
+  std::printf("Label phantom, scale %.2f, spacing 1 x 1.2 x 1.5, %d random rotations, %s: vertex RMS to each "
+              "label's true boundary (voxels)\n\n",
+              scale, seeds, no_flats ? "without flats" : "with flats (no sharpening)");
   std::printf("| label | midpoint | shared press | binary press of the label alone | shared / binary |\n|---|---|---|---|---|\n");
   const char* names[] = {"", "1 box", "2 sphere (pressed into the box)", "3 nested sphere", "4 slab"};
   for (int L = 1; L <= 4; ++L) {
