@@ -110,7 +110,7 @@ void expect_cad_faces(const FlatRun& r) {
 }
 
 TEST(Flats, RotatedBoxesHaveExactlySixFlatsWithinOneDegree) {
-  for (int seed = 1; seed <= 6; ++seed) {
+  for (int seed = 1; seed <= 3; ++seed) {
     SCOPED_TRACE("box 128 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::box, 128, seed);
     expect_six_faces(r);
@@ -125,9 +125,10 @@ TEST(Flats, RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats) {
   // faces since the stabbing refit (29 before: seed 15 has two faces 2
   // degrees off a lattice axis, see FacesNearALatticeAxisAreFound). One
   // pass: 23 of 30, 162 faces. Before the refit's rounding fix and the
-  // growth's slack: 28, 177 and 1 spurious.
+  // growth's slack: 28, 177 and 1 spurious. Here (CI time) seeds 1-12;
+  // the 30 are bench_flats' sweep.
   size_t exact = 0, found = 0, spurious = 0;
-  for (int seed = 1; seed <= 30; ++seed) {
+  for (int seed = 1; seed <= 12; ++seed) {
     SCOPED_TRACE("box 64 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::box, 64, seed);
     const Matches m = match_all(r.seg.flats, r.faces);
@@ -138,8 +139,8 @@ TEST(Flats, RotatedBoxesAt64AlmostAlwaysHaveExactlySixFlats) {
     spurious += bad;
     expect_guarantees(r.surface, r.seg, r.shape.volume);
   }
-  EXPECT_EQ(exact, 30u) << "rotations with exactly the six faces, of 30";
-  EXPECT_EQ(found, 180u) << "faces found, of 180";
+  EXPECT_EQ(exact, 12u) << "rotations with exactly the six faces, of 12";
+  EXPECT_EQ(found, 72u) << "faces found, of 72";
   EXPECT_EQ(spurious, 0u) << "flats matching no face or a face already taken";
 }
 
@@ -172,7 +173,7 @@ TEST(Flats, CadPartPlanarFacesFoundNoneSpurious) {
   // circle correction until the merge also tried each flat's own plane
   // (no plane stabbed both cores; each plane stabbed 98 % of the other's
   // members): each face is one flat.
-  for (int seed : {1, 2, 3, 4, 15, 20}) {
+  for (int seed : {1, 3, 15, 20}) {  // (CI time: bench_flats --shape cad-part sweeps 30)
     SCOPED_TRACE("cad-part 128 seed " + std::to_string(seed));
     const FlatRun r = run(ShapeKind::cad_part, 128, seed);
     expect_cad_faces(r);
@@ -185,7 +186,7 @@ TEST(Flats, CadPartAt256FoundNoneSpurious) {
   // Two rotations at 256^3, where tangent strips of the rounded corners and
   // pieces of faces once came out as spurious flats (the curved-test and
   // merge passes; their effect is measured in bench/ablation).
-  for (int seed : {3, 30}) {
+  for (int seed : {3}) {  // (CI time; seed 30 as well in bench_flats)
     SCOPED_TRACE("cad-part 256 seed " + std::to_string(seed));
     expect_cad_faces(run(ShapeKind::cad_part, rotated(ShapeKind::cad_part, 256, seed)));
   }
@@ -265,7 +266,7 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
   // labelled sharp curve may stray onto its foot (the tangent-borders pass;
   // without it the foot is labelled 20 voxels from any true crease, as
   // bench/ablation shows). Bound over four rotations.
-  for (int seed : {1, 2, 11, 18}) {
+  for (int seed : {1, 11}) {  // (CI time: seeds 2 and 18 too in bench_flats)
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
     const GeneratedShape g = rotated(ShapeKind::cad_part, 128, seed);
     Mesh tm = cad_part_mesh();

@@ -80,7 +80,7 @@ TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
   // a face (solid_crossing), 29 the flats' crease refit (0.33 / 0.18 / 0.41
   // before), 39 and 48 the snapping's wider look for a corner's third flat
   // (0.93 / 4.6 before).
-  for (int seed : {1, 2, 3, 8, 21, 29, 39, 48}) {
+  for (int seed : {1, 2, 3, 29}) {  // (CI time: bench_flats sweeps seeds 1-50)
     SCOPED_TRACE("box 128 seed " + std::to_string(seed));
     const GeneratedShape g = shape(ShapeKind::box, 128, seed);
     const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation);
