@@ -28,6 +28,12 @@ if [ -d "$shared/medical" ]; then
   # A CT segmentation (TotalSegmentator's aorta, 1.5 mm): input voxels vs Pressing.
   "$vp" render "$shared/medical/totalseg_aorta.nii.gz" "$shared/medical/totalseg_aorta.nii.gz" \
     --method voxels,pressing --view y --size 360x460 -o "$img/aorta.png"
+  # TotalSegmentator's 61-label map (3 mm), seen from behind: the shared midpoint surface vs the
+  # pressed one (press --labels), every face coloured by the label it bounds.
+  "$vp" -q extract "$shared/medical/totalseg_example_seg_fast_force_split.nii.gz" --labels -o "$work/labels-midpoint.ply"
+  "$vp" -q press "$shared/medical/totalseg_example_seg_fast_force_split.nii.gz" --labels all -o "$work/organs"
+  "$vp" render "$work/labels-midpoint.ply" "$work/organs/interfaces.ply" --color regions --view y --size 420x520 \
+    -o "$img/label-map.png"
   # MagicaVoxel's chr_knight: the voxels vs the faired, textured mesh (voxpress voxart).
   "$vp" render "$shared/vox/chr_knight.vox" "$shared/vox/chr_knight.vox" --method voxels,lanczos \
     --size 400x440 -o "$img/voxel-art.png"

@@ -113,7 +113,9 @@ Texture render_mesh(const Mesh& mesh, const RenderOptions& o) {
               cam.eye.dot(p)};
     }
     const Vec3 light = (cam.eye + 0.7 * cam.up + 0.35 * cam.right).normalized();
-    const MeshAttribute* face_reg = mesh.face_attribute("region");
+    // A label map's interfaces (label_in: the label a face bounds, seen
+    // from outside; interfaces_mesh) colour by label like flats by id.
+    const MeshAttribute* face_reg = mesh.face_attribute("region") ? mesh.face_attribute("region") : mesh.face_attribute("label_in");
     const MeshAttribute* vert_reg = mesh.vertex_attribute("region");
     // Region colours need regions; a mesh without them is drawn as usual.
     const Coloring coloring = o.coloring == Coloring::regions && !face_reg && !vert_reg ? Coloring::automatic : o.coloring;

@@ -101,6 +101,19 @@ TEST(Render, ColoursRegionsTexturesAndFeatures) {
   EXPECT_LT(top[2], 30);
   EXPECT_GT(bottom[2], 150);
   EXPECT_LT(bottom[0], 30);
+  // A label map's interfaces colour by label_in: two labels, two colours.
+  Mesh labelled = quad;
+  labelled.uvs.clear();
+  labelled.texture = {};
+  labelled.face_attributes = {{"label_in", ScalarType::u32, {3, 3}}, {"label_out", ScalarType::u32, {0, 0}}};
+  q.coloring = Coloring::regions;
+  const Texture three = render_mesh(labelled, q);
+  labelled.face_attributes[0].values = {3, 8};
+  const Texture two = render_mesh(labelled, q);
+  EXPECT_EQ(three.rgba[size_t(30 * 100 + 80) * 4], two.rgba[size_t(30 * 100 + 80) * 4]) << "the face of label 3";
+  EXPECT_NE(std::vector<uint8_t>(three.rgba.begin() + (70 * 100 + 20) * 4, three.rgba.begin() + (70 * 100 + 20) * 4 + 3),
+            std::vector<uint8_t>(two.rgba.begin() + (70 * 100 + 20) * 4, two.rgba.begin() + (70 * 100 + 20) * 4 + 3))
+      << "the face of label 8";
   RenderOptions tiny;
   tiny.width = 8;
   EXPECT_THROW(render_mesh(quad, tiny), UsageError);

@@ -24,7 +24,7 @@ View parse_view(const std::string& name);
 
 enum class Coloring {
   automatic,  ///< texture if present, else vertex colours, else the base colour
-  regions,    ///< the face (else vertex) attribute "region" (flat id >= 0; curved = grey); as automatic without one
+  regions,    ///< the face (else vertex) attribute "region" (flat id >= 0; curved = grey), else the face attribute "label_in" (a label map's interfaces); as automatic without one
   plain,      ///< the base colour only
 };
 
