@@ -35,8 +35,11 @@ phase "sanitized build done"
 # Voxart.SharedFilesHaveTheDocumentedContents); the crossing plates and the
 # generated shapes at random rotations (the property corpus holds both
 # kinds, smaller); the metric, truth and option-effect checks on 64-128^3
-# volumes (their code runs in the suites kept, on smaller inputs). The
-# corpus itself is smaller under the sanitizers (tests/test_util.cpp).
+# volumes (their code runs in the suites kept, on smaller inputs); the
+# voxelizer at random rotations and the shared medical volumes' documented
+# facts (their code runs in the other Voxelize and VolumeIO tests and the
+# fuzzers). The corpus itself is smaller under the sanitizers
+# (tests/test_util.cpp), and the pressing corpus runs one circle correction.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndItsCreasesAreFound:Sharpen.RotatedBoxesGetTheirEdgesBack:\
 Sharpen.SharpAngleOptionControlsTheLabels:Sharpen.ThinPlatesGetBothEdgesOfTheirRim:\
@@ -58,7 +61,8 @@ Metrics.MidpointRowOnFandisk:Metrics.RotatedBoxMatchesQuadrature:Metrics.Transla
 Truth.SharpEdges:Shapes.SampledVolumeMatchesAnalyticVolume:Flats.JunctionAngleOptionControlsJunctions:\
 Sharpen.CurvedCreasesOnlyWhereTheyContinueAFlatsCrease:Pressing.ArcLengthResamplingBeatsThePlainBilaplacian:\
 Pipeline.PressingStagesAndOverridesAreHonoured:Flats.WithoutFlatsTheResultIsThePlainPress:\
-Pressing.AnisotropicSpacingWorksInPhysicalSpace"
+Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtRandomRotations:\
+VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.
 runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 io_tests:0:1 extract_tests:0:1

@@ -52,7 +52,7 @@ class Mesh:
     def stats(self) -> dict[str, Any]:
         """method, sticks, vertices, triangles, iterations, flats, sharp_edges, keeps_classification, seconds_*."""
     def save(self, path: str, ascii: bool = False) -> None:
-        """Writes .ply .obj .stl .off .glb .gltf atomically (no partial file on failure)."""
+        """Writes .ply .obj .stl .off .glb .gltf .vtk .vtp atomically (no partial file on failure)."""
 
 def press(
     mask: npt.ArrayLike,
@@ -116,17 +116,19 @@ def press_labels(
     by all labels: where two labels touch, their meshes hold the same
     triangles (opposite orientations) at bit-identical positions.
     interfaces=True also returns that surface, each interface once, with
-    Mesh.label_pairs. separate=True (or a baseline method) meshes each label
+    Mesh.label_pairs. The shared surface gets each label's flats
+    (flats=False: none; min_flat_area, junction_angle apply) but no
+    sharpening. separate=True (or a baseline method) meshes each label
     alone, with press()'s flats and sharpening; touching labels' surfaces
-    may then overlap. Options: press()'s (iterations, tolerance; flats,
-    sharpen, ... with separate=True only).
+    may then overlap. Options: press()'s (iterations, tolerance, flats;
+    sharpen, sharp_angle, fit_rings, color_regions with separate=True only).
     """
 
 def read_volume(path: str) -> Tuple[npt.NDArray[Any], Lattice]:
     """A volume file (NRRD, NIfTI, MetaImage, TIFF) as an array indexed [i, j, k] (no copy) and its lattice."""
 
 def read_mesh(path: str) -> Mesh:
-    """A .ply .obj .stl .off mesh (STL welded)."""
+    """A .ply .obj .stl .off .glb .gltf .vtk .vtp mesh (STL welded)."""
 
 def check(mesh: Mesh, volume: Union[str, npt.ArrayLike, None] = None, **lattice: Any) -> dict[str, Any]:
     """check_mesh (closed, manifold, oriented, self-intersections); with a volume (path, or a mask with

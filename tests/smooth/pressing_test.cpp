@@ -49,8 +49,15 @@ TEST(SliceCurves, EveryStickLiesOnOneClosedCurvePerPlaneFamily) {
 TEST(Pressing, PropertyCorpusKeepsEveryGuarantee) {
   PressOptions o;
   o.iterations = 30;
+  // Under the sanitizers one correction: the others change the arithmetic,
+  // not the memory the iteration touches (CI time).
+#ifdef VOXPRESS_SANITIZED
+  const std::vector<double> corrections = {12.0};
+#else
+  const std::vector<double> corrections = {0.0, 12.0, 45.0};
+#endif
   for (const test::Case& c : test::property_volumes())
-    for (const double correction : {0.0, 12.0, 45.0}) {
+    for (const double correction : corrections) {
       SCOPED_TRACE(c.name + " circle correction " + std::to_string(correction));
       o.circle_correction = correction;
       StickSurface s = extract_sticks(c.volume);
