@@ -191,6 +191,14 @@ std::string format_double(double x) {
   return std::string(tmp, r.ptr);
 }
 
+Mesh welded_solid(const Mesh& m) {
+  Mesh solid = m;
+  solid.uvs.clear();
+  solid.texture = {};
+  weld_identical_vertices(solid);
+  return solid;
+}
+
 std::string format_typed(ScalarType t, double x) {
   if (t == ScalarType::f32) return format_double(double(float(x)));
   if (t == ScalarType::f64) return format_double(x);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "voxpress/core/error.h"
+#include "voxpress/core/mesh.h"
 #include "voxpress/core/volume.h"
 
 namespace voxpress::detail {
@@ -38,6 +39,11 @@ void read_range_into(const std::string& path, uint64_t offset, std::byte* out, u
 void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected);
 /// gzip (wrapper = 16 + 15) or zlib (15) compression of a buffer.
 std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzip_wrapper, int level = 1);
+
+/// A textured mesh as the closed solid, for formats that keep no texture
+/// (PLY, OFF, VTK, VTP): no uvs or texture, the vertices split at chart
+/// seams welded back.
+Mesh welded_solid(const Mesh& m);
 
 /// Reverses the byte order of `count` values of `width` bytes in place.
 void swap_bytes(std::byte* data, uint64_t count, size_t width);

@@ -346,15 +346,7 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
 
 void write_ply(const std::string& path, const Mesh& m, bool binary, Space space) {
   m.validate(path);
-  if (!m.uvs.empty()) {
-    // PLY keeps no texture here: the vertices split at chart seams are
-    // welded back, so the file is the closed solid.
-    Mesh solid = m;
-    solid.uvs.clear();
-    solid.texture = {};
-    weld_identical_vertices(solid);
-    return write_ply(path, solid, binary, space);
-  }
+  if (!m.uvs.empty()) return write_ply(path, welded_solid(m), binary, space);  // no texture: the closed solid
   std::ostringstream h;
   h << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\ncomment written by voxpress\n";
   if (space != Space::unknown) h << "comment SPACE=" << space_name(space) << "\n";  // read by 3D Slicer

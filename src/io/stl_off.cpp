@@ -240,13 +240,7 @@ Mesh read_off(const std::string& path, uint64_t max_bytes) {
 
 void write_off(const std::string& path, const Mesh& m) {
   m.validate(path);
-  if (!m.uvs.empty()) {  // as PLY: no texture, the seams welded back
-    Mesh solid = m;
-    solid.uvs.clear();
-    solid.texture = {};
-    weld_identical_vertices(solid);
-    return write_off(path, solid);
-  }
+  if (!m.uvs.empty()) return write_off(path, welded_solid(m));  // no texture: the closed solid
   write_stream_atomically(path, [&](std::ostream& out) {
     std::string buf = "OFF\n" + std::to_string(m.positions.size()) + " " + std::to_string(m.triangles.size()) + " 0\n";
     for (const Vec3& p : m.positions) {

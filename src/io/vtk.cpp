@@ -392,13 +392,7 @@ Mesh read_vtk(const std::string& path, uint64_t max_bytes) {
 
 void write_vtk(const std::string& path, const Mesh& m, bool binary, Space space) {
   m.validate(path);
-  if (!m.uvs.empty()) {  // seams welded back: the closed solid (as PLY)
-    Mesh solid = m;
-    solid.uvs.clear();
-    solid.texture = {};
-    weld_identical_vertices(solid);
-    return write_vtk(path, solid, binary, space);
-  }
+  if (!m.uvs.empty()) return write_vtk(path, welded_solid(m), binary, space);  // no texture: the closed solid
   write_stream_atomically(path, [&](std::ostream& out) {
     std::string buf;
     auto flush = [&] {

@@ -260,13 +260,7 @@ Mesh read_vtp(const std::string& path, uint64_t max_bytes) {
 
 void write_vtp(const std::string& path, const Mesh& m, Space space) {
   m.validate(path);
-  if (!m.uvs.empty()) {  // seams welded back: the closed solid (as PLY)
-    Mesh solid = m;
-    solid.uvs.clear();
-    solid.texture = {};
-    weld_identical_vertices(solid);
-    return write_vtp(path, solid, space);
-  }
+  if (!m.uvs.empty()) return write_vtp(path, welded_solid(m), space);  // no texture: the closed solid
   // Every array's bytes go to the appended block, each after its UInt64 size.
   std::string data, arrays_point, arrays_cell;
   auto add = [&](std::string& xml, const std::string& name, ScalarType t, int comps, size_t count, auto&& value) {
