@@ -170,6 +170,12 @@ def test_mesh_outputs_and_evaluation(tmp_path):
     assert mesh.sharp_edges.shape[1] == 2 and len(mesh.sharp_edges) > 0
     mesh.save(str(tmp_path / "m.obj"))
     assert voxpress.read_mesh(str(tmp_path / "m.obj")).faces.shape == mesh.faces.shape
+    for ext in ("vtp", "vtk"):  # VTK formats keep the doubles and the regions (cell data)
+        mesh.save(str(tmp_path / f"m.{ext}"))
+        back = voxpress.read_mesh(str(tmp_path / f"m.{ext}"))
+        np.testing.assert_array_equal(back.vertices, mesh.vertices)
+        np.testing.assert_array_equal(back.faces, mesh.faces)
+        np.testing.assert_array_equal(back.regions, mesh.regions)
     e = voxpress.evaluate(mesh, volume=str(vol), samples=20000)
     m0_mesh = voxpress.press(data, spacing=lat.spacing, origin=lat.origin, direction=lat.direction,
                              method="taubin", iterations=0)
