@@ -119,7 +119,10 @@ VtkCells vtk_cells_from_list(const std::string& path, const std::vector<double>&
     if (i >= list.size() || !whole_in(list[i], 0, double(list.size() - i - 1)))
       throw InputError(path, "cell " + std::to_string(k) + " has a bad size or runs past its list");
     const size_t n = size_t(list[i++]);
-    for (size_t j = 0; j < n; ++j) c.ids.push_back(int64_t(list[i++]));
+    for (size_t j = 0; j < n; ++j, ++i) {
+      if (!whole_in(list[i], 0, 4294967295.0)) throw InputError(path, "cell " + std::to_string(k) + " holds a bad index");
+      c.ids.push_back(int64_t(list[i]));
+    }
     c.offsets.push_back(int64_t(c.ids.size()));
   }
   if (i != list.size()) throw InputError(path, "a cell list holds more values than its cells use");
@@ -176,7 +179,10 @@ Mesh vtk_to_mesh(const std::string& path, VtkData& g) {
       m.colors.resize(n);
       const double scale = a.type == ScalarType::u8 ? 1.0 : 255.0;  // COLOR_SCALARS in ASCII are in [0, 1]
       for (size_t v = 0; v < n; ++v)
-        for (int c = 0; c < 4; ++c) m.colors[v][size_t(c)] = uint8_t(std::clamp(std::round(a.values[4 * v + size_t(c)] * scale), 0.0, 255.0));
+        for (int c = 0; c < 4; ++c) {
+          const double x = std::round(a.values[4 * v + size_t(c)] * scale);
+          m.colors[v][size_t(c)] = std::isfinite(x) ? uint8_t(std::clamp(x, 0.0, 255.0)) : 0;  // no NaN to integer
+        }
     } else if (a.comps == 1) {
       m.vertex_attributes.push_back({a.name, a.type, std::move(a.values)});
     }

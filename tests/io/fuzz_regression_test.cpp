@@ -18,7 +18,7 @@ struct Finding {
 
 void read_any(const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".off")
+  if (ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".off" || ext == ".vtk" || ext == ".vtp")
     (void)read_mesh(path);
   else if (ext == ".vox" || ext == ".vxl")
     (void)read_voxel_art(path);
@@ -84,6 +84,16 @@ std::vector<Finding> findings() {
            "0000010000002801030001000000010000002901030100000000000025004301030001000000ffffffffffffffffffff72010000b76d"
            "5b8e8e8e010501"),
        "larger than the image"},
+      // UBSan: a cell list's index of 4.4e20 (and a strip's of 5.6e73)
+      // converted to an integer (vtk.cpp, legacy cell lists). Minimized.
+      {"huge-cell-index.vtk",
+       "# vtk DataFile Version 3.0\nstrip\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0 1 0 0 0 1 0 1 1 0\n"
+       "LINES 1 3\n2 444444444444444444444 3\n",
+       "bad index"},
+      {"huge-strip-index.vtk",
+       "# vtk DataFile Version 3.0\nstrip\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0 1 0 0 0 1 0 1 1 0\n"
+       "TRIANGLE_STRIPS 1 5\n4 0 55555555555555555555555555555555555555555555555555555555555555555555555555 2 3\n",
+       "bad index"},
   };
 }
 
