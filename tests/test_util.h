@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -133,5 +134,7 @@ std::string vxl_file();
 /// Runs the voxpress CLI with `args`; returns the exit code, fills output
 /// with stdout and stderr combined.
 int run_cli(const std::string& args, std::string* output = nullptr);
+/// Lines in a command's output (one error = one line).
+inline size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 
 }  // namespace voxpress::test
