@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # scripts/test.sh — sets everything up (apt packages, Node test tools,
 # Chromium), builds in Release and runs the whole test suite, then builds the
-# library and its unit and property tests again with AddressSanitizer and
-# UndefinedBehaviorSanitizer (clang, -O1, build-asan/) and runs them. CI runs
+# library again with AddressSanitizer and UndefinedBehaviorSanitizer (clang,
+# -O1, build-asan/) and runs its unit and property tests on it. CI runs
 # exactly this. VOXPRESS_NO_SANITIZE=1 skips the second part (local use).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
