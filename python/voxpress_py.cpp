@@ -270,23 +270,15 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
     const LabelTable table = label_table(scalar);
     chosen = select_labels(table, values, scalar.source);
     if (shared && !table.layered) {
-      require_float32_room(scalar.lattice, o, scalar.source);
-      s = extract_shared_surface(scalar);
-      PressOptions po = o.press;
-      o.overrides.apply(po);
-      std::optional<SharedFlats> sf;
-      if (o.passes.on(Pass::flats)) {
-        FlatOptions fo = o.flat;
-        fo.passes = o.passes;
-        sf = find_shared_flats(scalar, s, po, fo);
-      }
-      ps = press_shared(s, po, sf ? &*sf : nullptr);
+      SharedLabels r = press_shared_labels(scalar, table, o);
+      s = std::move(r.surface);
+      ps = r.press;
       for (const LabelInfo& l : chosen) {
         const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
         meshes.push_back(label_mesh(s, uint32_t(it - s.labels.begin())));
-        flats.push_back(sf ? size_t(std::count(sf->flat_label.begin(), sf->flat_label.end(), uint32_t(l.value))) : 0);
+        flats.push_back(r.flats ? r.flats->flats_of(l.value) : 0);
       }
-      shared_flats = sf ? sf->flats.size() : 0;
+      shared_flats = r.flats ? r.flats->flats.size() : 0;
     } else {
       for (LabelSurface& ls : press_labels(scalar, chosen, o)) {
         meshes.push_back(std::move(ls.result.mesh));

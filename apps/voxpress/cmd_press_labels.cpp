@@ -78,20 +78,13 @@ struct LabelPiece {
 // each chosen label's closed mesh is cut from it, so touching labels share
 // their interface vertex for vertex. `combined` gets the whole surface with
 // the two labels of each triangle.
-std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vector<LabelInfo>& chosen,
-                                      const SurfaceOptions& so, Mesh& combined, nlohmann::json& stats) {
-  require_float32_room(volume.lattice, so, volume.source);
-  Stopwatch clock;
-  SharedSurface s = extract_shared_surface(volume);
-  const double t_extract = clock.seconds();
-  // Flats per label (shared_flats.h), unless --no-flats.
-  std::optional<SharedFlats> flats;
-  if (so.passes.on(Pass::flats)) {
-    FlatOptions fo = so.flat;
-    fo.passes = so.passes;
-    flats = find_shared_flats(volume, s, so.press, fo, so.progress);
-  }
-  const SharedPressStats ps = press_shared(s, so.press, flats ? &*flats : nullptr);
+std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const LabelTable& table,
+                                      const std::vector<LabelInfo>& chosen, const SurfaceOptions& so, Mesh& combined,
+                                      nlohmann::json& stats) {
+  const SharedLabels r = press_shared_labels(volume, table, so);
+  const SharedSurface& s = r.surface;
+  const SharedPressStats& ps = r.press;
+  const std::optional<SharedFlats>& flats = r.flats;
   stats = {{"vertices", {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}}},
            {"junction_curves", ps.junction_curves},
            {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
@@ -101,7 +94,7 @@ std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vec
            {"cubes_reset", ps.cubes_reset},
            {"flats", nlohmann::json::array()},
            {"flat_vertices", ps.flat_vertices},
-           {"seconds", {{"extract", t_extract}, {"flats", flats ? flats->seconds : 0.0}, {"press", ps.seconds}}}};
+           {"seconds", {{"extract", r.seconds_extract}, {"flats", flats ? flats->seconds : 0.0}, {"press", ps.seconds}}}};
   if (flats)  // each flat: the label it was found on, its plane and area
     for (size_t i = 0; i < flats->flats.size(); ++i) {
       const Flat& f = flats->flats[i];
@@ -114,8 +107,7 @@ std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const std::vec
   std::vector<LabelPiece> out;
   for (const LabelInfo& l : chosen) {
     const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
-    const size_t own = flats ? size_t(std::count(flats->flat_label.begin(), flats->flat_label.end(), uint32_t(l.value))) : 0;
-    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), own});
+    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), flats ? flats->flats_of(l.value) : 0});
   }
   combined = interfaces_mesh(s);
   return out;
@@ -147,7 +139,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   nlohmann::json shared_stats;
   std::vector<LabelPiece> pieces;
   if (shared) {
-    pieces = shared_pieces(volume, chosen, so, combined, shared_stats);
+    pieces = shared_pieces(volume, table, chosen, so, combined, shared_stats);
   } else {
     for (LabelSurface& s : press_labels(volume, chosen, so))
       pieces.push_back({s.label, std::move(s.result.mesh), s.result.flats.flats.size()});

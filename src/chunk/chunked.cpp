@@ -45,11 +45,6 @@ struct KeyCodec {
 
 }  // namespace
 
-uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& pl, int axis) {
-  const uint64_t px = uint64_t(dims[0] + 2), py = uint64_t(dims[1] + 2);
-  return ((uint64_t(pl[2]) * py + uint64_t(pl[1])) * 3 + uint64_t(axis)) * px + uint64_t(pl[0]);
-}
-
 ChunkGrid::ChunkGrid(const std::array<int64_t, 3>& d, const ChunkOptions& o) : dims(d), chunk(o.chunk), halo(o.halo) {
   if (chunk < kMinChunk) throw UsageError("--chunk must be at least " + std::to_string(kMinChunk) + " samples");
   if (halo < 0 || halo > kMaxHalo) throw UsageError("the halo must be in [0, " + std::to_string(kMaxHalo) + "] samples");

@@ -148,6 +148,11 @@ std::array<Vec3, 2> StickSurface::sample_points(size_t s) const {
   return {a, b};
 }
 
+uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& pl, int axis) {
+  const uint64_t px = uint64_t(dims[0] + 2), py = uint64_t(dims[1] + 2);
+  return ((uint64_t(pl[2]) * py + uint64_t(pl[1])) * 3 + uint64_t(axis)) * px + uint64_t(pl[0]);
+}
+
 uint64_t count_sticks(const BinaryVolume& volume) {
   const Padded pv(volume);
   const auto info = classify_rows(pv, nullptr);

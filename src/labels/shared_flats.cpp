@@ -16,16 +16,6 @@
 namespace voxpress {
 namespace {
 
-// A stick's key: its axis and its lower sample's index, each coordinate + 1
-// (samples beyond the lattice are -1), on a grid of the volume's dims + 2.
-struct StickKey {
-  std::array<int64_t, 3> grid;
-  uint64_t operator()(const std::array<int64_t, 3>& lower, int axis) const {
-    return ((uint64_t(lower[2] + 1) * uint64_t(grid[1]) + uint64_t(lower[1] + 1)) * uint64_t(grid[0]) +
-            uint64_t(lower[0] + 1)) * 3 + uint64_t(axis);
-  }
-};
-
 // One label's flats, as (shared vertex, t, barrier, its flat) entries.
 struct LabelFlats {
   std::vector<Flat> flats;
@@ -40,31 +30,38 @@ struct LabelFlats {
 
 }  // namespace
 
-SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s, const PressOptions& press,
-                              const FlatOptions& options, Progress* progress) {
+size_t SharedFlats::flats_of(double value) const {
+  return size_t(std::count(flat_label.begin(), flat_label.end(), uint32_t(value)));
+}
+
+SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s, const std::vector<LabelInfo>& labels,
+                              const PressOptions& press, const FlatOptions& options, Progress* progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = s.mesh.positions.size();
   SharedFlats out;
   out.t.assign(n, std::numeric_limits<double>::quiet_NaN());
   out.barrier.assign(n, 0);
   out.region.assign(n, -1);
-  // The shared stick vertices by key, for the labels' lookups.
-  const StickKey key{{volume.lattice.dims[0] + 2, volume.lattice.dims[1] + 2, volume.lattice.dims[2] + 2}};
+  // The shared stick vertices by global stick key (lower sample padded),
+  // for the labels' lookups.
+  const auto& dims = volume.lattice.dims;
+  auto key = [&](const std::array<int64_t, 3>& lower, int axis) {
+    return stick_key(dims, {lower[0] + 1, lower[1] + 1, lower[2] + 1}, axis);
+  };
   std::vector<std::pair<uint64_t, uint32_t>> sticks;
   for (uint32_t v = 0; v < n; ++v)
     if (s.kind[v] < 3) sticks.push_back({key(s.corner[v], s.kind[v]), v});
   std::sort(sticks.begin(), sticks.end());
 
-  const LabelTable table = label_table(volume);
-  std::vector<LabelFlats> per(table.labels.size());
+  std::vector<LabelFlats> per(labels.size());
   FlatOptions fo = options;
   fo.progress = nullptr;
   PressOptions po = press;
   po.progress = nullptr;
-  if (progress) progress->begin("flats per label", table.labels.size());
+  if (progress) progress->begin("flats per label", labels.size());
   std::atomic<uint64_t> done{0};
-  tbb::parallel_for(size_t(0), table.labels.size(), [&](size_t i) {
-    const LabelInfo& label = table.labels[i];
+  tbb::parallel_for(size_t(0), labels.size(), [&](size_t i) {
+    const LabelInfo& label = labels[i];
     const BinaryVolume mask = label_mask(volume, label);
     const std::array<int64_t, 3> lo = {std::max<int64_t>(0, label.lo[0] - 1), std::max<int64_t>(0, label.lo[1] - 1),
                                        std::max<int64_t>(0, label.lo[2] - 1)};
@@ -92,7 +89,7 @@ SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s
     const int32_t base = int32_t(out.flats.size());
     for (const Flat& f : per[i].flats) {
       out.flats.push_back(f);
-      out.flat_label.push_back(uint32_t(table.labels[i].value));
+      out.flat_label.push_back(uint32_t(labels[i].value));
     }
     for (const auto& e : per[i].entries) {
       out.barrier[e.vertex] |= e.barrier;

@@ -447,4 +447,21 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   return st;
 }
 
+SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& o) {
+  require_float32_room(volume.lattice, o, volume.source);
+  SharedLabels r;
+  const auto t0 = std::chrono::steady_clock::now();
+  r.surface = extract_shared_surface(volume);
+  r.seconds_extract = detail::seconds_since(t0);
+  PressOptions po = o.press;
+  o.overrides.apply(po);
+  if (o.passes.on(Pass::flats)) {
+    FlatOptions fo = o.flat;
+    fo.passes = o.passes;
+    r.flats = find_shared_flats(volume, r.surface, table.labels, po, fo, o.progress);
+  }
+  r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr);
+  return r;
+}
+
 }  // namespace voxpress

@@ -152,9 +152,9 @@ TEST(SharedPress, AssemblyOfBoxesGetsItsFlats) {
     const SharedSurface mid = extract_shared_surface(a.volume);
     SharedSurface plain = mid, flat = mid;
     press_shared(plain);
-    const SharedFlats f = find_shared_flats(a.volume, flat, PressOptions{}, FlatOptions{});
+    const SharedFlats f = find_shared_flats(a.volume, flat, label_table(a.volume).labels, PressOptions{}, FlatOptions{});
     for (uint32_t value : {1u, 2u})
-      EXPECT_GE(std::count(f.flat_label.begin(), f.flat_label.end(), value), 5) << "label " << value;
+      EXPECT_GE(f.flats_of(value), 5u) << "label " << value;
     const SharedPressStats st = press_shared(flat, PressOptions{}, &f);
     EXPECT_GT(st.flat_vertices, mid.stick_vertices / 2) << "most of a box is flat";
     for (uint32_t L = 1; L < flat.labels.size(); ++L) {
@@ -185,10 +185,10 @@ TEST(SharedPress, SameBytesForOneAndManyThreads) {
   SharedSurface a = extract_shared_surface(boxes), b = a;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    const SharedFlats f = find_shared_flats(boxes, a, PressOptions{}, FlatOptions{});
+    const SharedFlats f = find_shared_flats(boxes, a, label_table(boxes).labels, PressOptions{}, FlatOptions{});
     press_shared(a, PressOptions{}, &f);
   }
-  const SharedFlats f = find_shared_flats(boxes, b, PressOptions{}, FlatOptions{});
+  const SharedFlats f = find_shared_flats(boxes, b, label_table(boxes).labels, PressOptions{}, FlatOptions{});
   EXPECT_GT(f.frozen, 0u);
   press_shared(b, PressOptions{}, &f);
   EXPECT_EQ(a.mesh.positions, b.mesh.positions);

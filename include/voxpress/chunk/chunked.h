@@ -88,10 +88,6 @@ struct SurfacePiece {
   uint64_t count = 1;               ///< merged pieces: the blocks [block, block + count)
 };
 
-/// Global key of a stick: its lower sample (p, q, r) in padded index space
-/// (unpadded + 1) and axis a, ordered as the whole-volume run orders sticks:
-/// ((r * (ny + 2) + q) * 3 + a) * (nx + 2) + p.
-uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& padded_lower, int axis);
 
 /// Block b's piece of the surface: `samples` holds grid.with_halo(b) (its
 /// lattice's dims must match). With options (as chunk_surface_options

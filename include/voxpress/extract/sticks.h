@@ -72,6 +72,12 @@ struct ExtractStats {
 StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& options = {},
                             ExtractStats* stats = nullptr);
 
+/// Global key of a stick of a volume of `dims` samples: its lower sample
+/// (p, q, r) in padded index space (unpadded + 1) and axis a, ordered as
+/// extract_sticks orders sticks: ((r * (ny + 2) + q) * 3 + a) * (nx + 2) + p.
+/// Names a stick across blocks (chunked.h) and across labels (shared_flats.h).
+uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& padded_lower, int axis);
+
 /// The classification pass alone: number of sticks (used by `voxpress info`).
 uint64_t count_sticks(const BinaryVolume& volume);
 

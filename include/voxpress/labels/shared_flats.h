@@ -20,6 +20,7 @@
 #include "voxpress/core/progress.h"
 #include "voxpress/core/volume.h"
 #include "voxpress/features/flats.h"
+#include "voxpress/labels/labels.h"
 #include "voxpress/labels/shared_surface.h"
 
 namespace voxpress {
@@ -32,12 +33,15 @@ struct SharedFlats {
   std::vector<uint32_t> flat_label;  ///< per flat: the value of the label it was found on
   size_t frozen = 0;               ///< vertices frozen
   double seconds = 0;
+  /// Flats found on the label of this value.
+  size_t flats_of(double value) const;
 };
 
-/// The flats of every label of `surface` (taken from `volume`, the label map
-/// it was extracted from), mapped onto the shared vertices. Labels in
-/// parallel; deterministic for any thread count.
-SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& surface, const PressOptions& press,
+/// The flats of every label of `labels` (label_table(volume).labels: their
+/// boxes) mapped onto the shared vertices of `surface`, extracted from
+/// `volume`. Labels in parallel; deterministic for any thread count.
+SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& surface,
+                              const std::vector<LabelInfo>& labels, const PressOptions& press,
                               const FlatOptions& flats, Progress* progress = nullptr);
 
 }  // namespace voxpress

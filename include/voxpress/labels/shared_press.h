@@ -30,6 +30,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 
 #include "voxpress/labels/shared_flats.h"
 #include "voxpress/labels/shared_surface.h"
@@ -56,5 +57,18 @@ struct SharedPressStats {
 /// borders cut the slice curves. Deterministic for any thread count.
 SharedPressStats press_shared(SharedSurface& surface, const PressOptions& options = {},
                               const SharedFlats* flats = nullptr);
+
+/// What `press --labels` and Python's press_labels() do by default: the
+/// shared surface of `volume` (whose labels and boxes `table` lists),
+/// each label's flats when options.passes has them, pressed by
+/// options.press (with options.overrides). Throws InputError when float32
+/// output could not keep every sample on its side (require_float32_room).
+struct SharedLabels {
+  SharedSurface surface;
+  std::optional<SharedFlats> flats;  ///< empty with --no-flats
+  SharedPressStats press;
+  double seconds_extract = 0;
+};
+SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& options);
 
 }  // namespace voxpress
