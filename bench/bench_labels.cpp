@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
     SharedSurface s = mid;
     double t0 = now();
     std::optional<SharedFlats> sf;
-    if (!no_flats) sf = find_shared_flats(v, s, label_table(v).labels, po, fo);
+    if (!no_flats) sf = find_shared_flats(masks_in(v), s, label_table(v).labels, po, fo);
     const SharedPressStats st = press_shared(s, po, sf ? &*sf : nullptr);
     t_shared += now() - t0;
     for (uint32_t L = 1; L < s.labels.size(); ++L) {

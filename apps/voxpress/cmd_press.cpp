@@ -184,7 +184,7 @@ Pressed press_chunked_file(const PressCmd& c, const SurfaceOptions& so, const Gl
 void run_press(const PressCmd& c, const Global& g) {
   const bool labels = !c.labels.empty();
   if (labels) {
-    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--chunk", "--halo"})
+    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--halo"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --labels");
     check_paths({c.input}, {{c.stats_json, OutputKind::json}});
   } else {
@@ -234,6 +234,7 @@ void run_press(const PressCmd& c, const Global& g) {
     o.ascii = c.ascii;
     o.check = c.check;
     o.separate = c.separate;
+    if (c.cmd->count("--chunk")) o.chunks = c.chunks;
     run_press_labels(c.input, c.in, so, o, g);
     return;
   }
@@ -367,7 +368,8 @@ void register_press(CLI::App& app, Global& g) {
   auto* ch = cmd->add_option_group("chunks", "Block by block, for volumes larger than memory");
   ch->add_option("--chunk", c->chunks.chunk,
                  "Read the volume in blocks of this many samples per side (raw NRRD / .raw from disk) and stitch "
-                 "their sticks: the same mesh as without, the volume never whole in memory")
+                 "their sticks: the same mesh as without, the volume never whole in memory (with --labels: the "
+                 "shared surface of every label, from the blocks)")
       ->check(CLI::Range(int64_t(8), int64_t(1) << 20));
   ch->add_option("--halo", c->chunks.halo,
                  "Also press each block apart, reading this many samples around it (memory: one block's surface; "

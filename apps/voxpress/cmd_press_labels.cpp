@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <memory>
 #include <set>
 #include <unistd.h>
 
@@ -74,27 +75,22 @@ struct LabelPiece {
   size_t flats = 0;
 };
 
-// The default: one shared surface of every label, pressed (press_shared);
-// each chosen label's closed mesh is cut from it, so touching labels share
-// their interface vertex for vertex. `combined` gets the whole surface with
-// the two labels of each triangle.
-std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const LabelTable& table,
-                                      const std::vector<LabelInfo>& chosen, const SurfaceOptions& so, Mesh& combined,
-                                      nlohmann::json& stats) {
-  const SharedLabels r = press_shared_labels(volume, table, so);
+// The stats of the shared surface's press for --stats-json.
+nlohmann::json shared_json(const SharedLabels& r) {
   const SharedSurface& s = r.surface;
   const SharedPressStats& ps = r.press;
   const std::optional<SharedFlats>& flats = r.flats;
-  stats = {{"vertices", {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}}},
-           {"junction_curves", ps.junction_curves},
-           {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
-           {"plane_curves", ps.plane_curves},
-           {"iterations", {{"junctions", ps.junctions.iterations}, {"interfaces", ps.interfaces.iterations}}},
-           {"cubes_pinned", ps.cubes_pinned},
-           {"cubes_reset", ps.cubes_reset},
-           {"flats", nlohmann::json::array()},
-           {"flat_vertices", ps.flat_vertices},
-           {"seconds", {{"extract", r.seconds_extract}, {"flats", flats ? flats->seconds : 0.0}, {"press", ps.seconds}}}};
+  nlohmann::json stats = {
+      {"vertices", {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}}},
+      {"junction_curves", ps.junction_curves},
+      {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
+      {"plane_curves", ps.plane_curves},
+      {"iterations", {{"junctions", ps.junctions.iterations}, {"interfaces", ps.interfaces.iterations}}},
+      {"cubes_pinned", ps.cubes_pinned},
+      {"cubes_reset", ps.cubes_reset},
+      {"flats", nlohmann::json::array()},
+      {"flat_vertices", ps.flat_vertices},
+      {"seconds", {{"extract", r.seconds_extract}, {"flats", flats ? flats->seconds : 0.0}, {"press", ps.seconds}}}};
   if (flats)  // each flat: the label it was found on, its plane and area
     for (size_t i = 0; i < flats->flats.size(); ++i) {
       const Flat& f = flats->flats[i];
@@ -104,13 +100,57 @@ std::vector<LabelPiece> shared_pieces(const ScalarVolume& volume, const LabelTab
                                 {"area", f.area},
                                 {"sticks", f.sticks}});
     }
+  return stats;
+}
+
+// Each chosen label's closed mesh cut from the pressed shared surface, so
+// touching labels share their interface vertex for vertex.
+std::vector<LabelPiece> shared_pieces(const SharedLabels& r, const std::vector<LabelInfo>& chosen) {
+  const SharedSurface& s = r.surface;
   std::vector<LabelPiece> out;
   for (const LabelInfo& l : chosen) {
     const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
-    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), flats ? flats->flats_of(l.value) : 0});
+    out.push_back({l, label_mesh(s, uint32_t(it - s.labels.begin())), r.flats ? r.flats->flats_of(l.value) : 0});
   }
-  combined = interfaces_mesh(s);
   return out;
+}
+
+// The label map: in memory, or (--chunk) a file read block by block, its
+// table and shared surface from one pass over the blocks.
+struct LabelSource {
+  std::optional<ScalarVolume> volume;
+  std::shared_ptr<const VolumeFile> file;
+  Lattice lattice;
+  LabelTable table;
+  std::optional<SharedSurface> surface;  // --chunk: assembled from the blocks
+  LabelMasks masks;
+  double seconds_extract = 0;
+  size_t blocks = 0;
+  bool streamed = false;
+};
+
+LabelSource open_labels(const std::string& input, const InputOptions& in, const LabelOutput& o, const Global& g,
+                        Progress* progress) {
+  LabelSource src;
+  if (!o.chunks) {
+    src.volume = load_volume(input, in, g);
+    src.lattice = src.volume->lattice;
+    src.table = label_table(*src.volume);
+    src.masks = masks_in(*src.volume);
+    return src;
+  }
+  src.file = std::make_shared<const VolumeFile>(input, in.read_options(g));
+  src.lattice = src.file->header().lattice;
+  src.streamed = src.file->streams();
+  const BoxRead read = [file = src.file](const Box& box) { return file->read(box); };
+  Stopwatch clock;
+  ChunkedLabels c = extract_labels_chunked(src.file->header(), read, *o.chunks, progress);
+  src.seconds_extract = clock.seconds();
+  src.table = std::move(c.table);
+  src.surface = std::move(c.surface);
+  src.blocks = c.blocks;
+  src.masks = masks_read(src.lattice, input, read);
+  return src;
 }
 
 }  // namespace
@@ -119,10 +159,12 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
                       const LabelOutput& o, const Global& g) {
   namespace fs = std::filesystem;
   check_label_output(o);
+  if (o.chunks && o.separate) throw UsageError("--separate does not apply with --chunk (the shared surface is meshed block by block)");
+  if (o.chunks && options.method != Method::pressing) throw UsageError("--chunk with --labels runs --method pressing only");
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
-  const ScalarVolume volume = load_volume(input, in, g);
-  LabelTable table = label_table(volume);
+  LabelSource src = open_labels(input, in, o, g, bar.get());
+  LabelTable& table = src.table;
   if (!o.names_file.empty()) {
     const auto names = read_label_names(o.names_file);
     for (LabelInfo& l : table.labels)
@@ -139,9 +181,14 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   nlohmann::json shared_stats;
   std::vector<LabelPiece> pieces;
   if (shared) {
-    pieces = shared_pieces(volume, table, chosen, so, combined, shared_stats);
+    SharedLabels r = src.surface ? press_shared_labels(std::move(*src.surface), src.masks, table, so, input)
+                                 : press_shared_labels(*src.volume, table, so);
+    if (src.surface) r.seconds_extract = src.seconds_extract;
+    shared_stats = shared_json(r);
+    pieces = shared_pieces(r, chosen);
+    combined = interfaces_mesh(r.surface);
   } else {
-    for (LabelSurface& s : press_labels(volume, chosen, so))
+    for (LabelSurface& s : press_labels(*src.volume, chosen, so))
       pieces.push_back({s.label, std::move(s.result.mesh), s.result.flats.flats.size()});
   }
 
@@ -168,7 +215,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
         touches.push_back({{"label", value_json(c.a == s.label.value ? c.b : c.a)}, {"sticks", c.sticks}});
     e["touches"] = touches;
     if (o.check) {
-      const BinaryVolume mask = label_mask(volume, s.label);
+      const BinaryVolume mask = src.masks(s.label);
       e["checks"] = check_surface(s.mesh, mask, bar.get(), "label " + format_value(s.label.value), strict);
     }
     list.push_back(e);
@@ -177,12 +224,12 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   fs::create_directories(o.folder);
   MeshWriteOptions wo;
   wo.ascii = o.ascii;
-  wo.space = volume.lattice.space;
+  wo.space = src.lattice.space;
   for (size_t i = 0; i < pieces.size(); ++i) write_mesh(files[i], pieces[i].mesh, wo);
   nlohmann::json manifest = {{"input", input},
                              {"layered", table.layered},
                              {"shared", shared},
-                             {"lattice", lattice_json(volume.lattice)},
+                             {"lattice", lattice_json(src.lattice)},
                              {"labels", list}};
   if (shared) {
     // The whole surface, each interface once, its two labels as face
@@ -216,6 +263,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
     j["command"] = "press --labels";
     j["seconds"] = {{"read", seconds_read}, {"total", clock.seconds()}};
     if (shared) j["shared_surface"] = shared_stats;
+    if (o.chunks) j["chunks"] = {{"chunk", o.chunks->chunk}, {"blocks", src.blocks}, {"streamed", src.streamed}};
     j["peak_memory_bytes"] = peak_rss_bytes();
     write_json(o.stats_json, j);
   }

@@ -163,6 +163,7 @@ struct LabelOutput {
   std::string stats_json;
   bool ascii = false, check = false;
   bool separate = false;   ///< --separate: each label alone (press_labels), not the shared surface
+  std::optional<ChunkOptions> chunks;  ///< --chunk: the file read block by block
 };
 /// Throws UsageError for an unknown format, an -o that is a file, a missing
 /// or unwritable parent folder: before any work.

@@ -26,6 +26,7 @@
 #include "voxpress/labels/shared_surface.h"
 #include "voxpress/labels/shared_press.h"
 #include "voxpress/chunk/chunked.h"
+#include "voxpress/chunk/chunked_labels.h"
 #include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
 #include "voxpress/voxart/polygonize.h"

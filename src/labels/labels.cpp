@@ -78,16 +78,18 @@ struct LayerScan {
   std::vector<LabelContact> contacts;
 };
 
-// One pass over one layer: counts and boxes, and (when wanted) the contacts
-// between labels along lattice edges, from the current and previous slices
-// of dense numbers (two slices of memory, not a volume).
+// One pass over one layer of the box `read` of a volume whose dims are `n`:
+// counts and boxes of the samples in `core`, and (when wanted) the contacts
+// between labels along the lattice edges whose upper sample is in `core`
+// (each edge of the volume once over blocks that tile it), from the current
+// and previous slices of dense numbers (two slices of memory, not a volume).
 template <class T>
 LayerScan scan_layer(const ScalarVolume& v, std::span<const T> values, int64_t layer, size_t max_labels,
-                     bool contacts) {
+                     bool contacts, const Box& read, const Box& core, const std::array<int64_t, 3>& n) {
   const auto& d = v.lattice.dims;
   const int64_t nx = d[0], ny = d[1], nz = d[2], nc = v.components;
   LabelIndex<T> index(v, max_labels);
-  std::vector<LabelInfo> info;
+  std::vector<LabelInfo> info;  // by dense number - 1; samples == 0: not in the core
   std::vector<uint32_t> cur(size_t(nx * ny)), prev(size_t(nx * ny));
   std::unordered_map<uint64_t, uint64_t> pairs;
   auto touch = [&](uint32_t a, uint32_t b) {
@@ -95,72 +97,107 @@ LayerScan scan_layer(const ScalarVolume& v, std::span<const T> values, int64_t l
     if (a > b) std::swap(a, b);
     ++pairs[(uint64_t(a) << 32) | b];
   };
+  auto owned = [&](int64_t x, int a) { return x >= core.lo[size_t(a)] && x < core.hi[size_t(a)]; };
   for (int64_t k = 0; k < nz; ++k) {
-    for (int64_t j = 0; j < ny; ++j)
+    const int64_t gk = read.lo[2] + k;
+    for (int64_t j = 0; j < ny; ++j) {
+      const int64_t gj = read.lo[1] + j;
+      const bool row_owned = owned(gk, 2) && owned(gj, 1);
       for (int64_t i = 0; i < nx; ++i) {
         const uint64_t s = v.lattice.linear(i, j, k);
         const uint32_t id = index(values[size_t(s * uint64_t(nc) + uint64_t(layer))]);
         cur[size_t(i + nx * j)] = id;
+        const int64_t gi = read.lo[0] + i;
+        if (!row_owned || !owned(gi, 0)) continue;
         if (id != 0) {
-          if (id > info.size()) {
-            info.resize(id);
-            LabelInfo& l = info[id - 1];
+          if (id > info.size()) info.resize(id);
+          LabelInfo& l = info[id - 1];
+          const int64_t p[3] = {gi, gj, gk};
+          if (l.samples == 0) {
             l.value = index.values[id];
             l.layer = layer;
-            l.lo = {i, j, k};
-            l.hi = {i, j, k};
+            l.lo = {gi, gj, gk};
+            l.hi = {gi, gj, gk};
           }
-          LabelInfo& l = info[id - 1];
           ++l.samples;
-          const int64_t p[3] = {i, j, k};
           for (int a = 0; a < 3; ++a) {
             l.lo[size_t(a)] = std::min(l.lo[size_t(a)], p[a]);
             l.hi[size_t(a)] = std::max(l.hi[size_t(a)], p[a]);
           }
         }
         if (!contacts) continue;
-        // Edges to the lower neighbours; the lattice's border faces the background.
-        if (i > 0) touch(cur[size_t(i - 1 + nx * j)], id);
-        if (j > 0) touch(cur[size_t(i + nx * (j - 1))], id);
-        if (k > 0) touch(prev[size_t(i + nx * j)], id);
+        // Edges to the lower neighbours (in the read box: it holds one
+        // sample below the core); the lattice's border faces the background.
+        if (gi > 0) touch(cur[size_t(i - 1 + nx * j)], id);
+        if (gj > 0) touch(cur[size_t(i + nx * (j - 1))], id);
+        if (gk > 0) touch(prev[size_t(i + nx * j)], id);
         if (id != 0) {
-          const int border = (i == 0) + (i == nx - 1) + (j == 0) + (j == ny - 1) + (k == 0) + (k == nz - 1);
+          const int border = (gi == 0) + (gi == n[0] - 1) + (gj == 0) + (gj == n[1] - 1) + (gk == 0) + (gk == n[2] - 1);
           if (border) pairs[uint64_t(id)] += uint64_t(border);
         }
       }
+    }
     std::swap(cur, prev);
   }
   LayerScan out;
-  out.labels = std::move(info);
-  for (const auto& [key, n] : pairs) {
+  for (LabelInfo& l : info)
+    if (l.samples) out.labels.push_back(std::move(l));
+  for (const auto& [key, count] : pairs) {
     const double a = index.values[key >> 32], b = index.values[key & 0xffffffffu];
-    out.contacts.push_back({std::min(a, b), std::max(a, b), n});
+    out.contacts.push_back({std::min(a, b), std::max(a, b), count});
   }
-  std::sort(out.contacts.begin(), out.contacts.end(),
-            [](const LabelContact& x, const LabelContact& y) { return std::tie(x.a, x.b) < std::tie(y.a, y.b); });
   return out;
 }
 
 }  // namespace
 
-LabelTable label_table(const ScalarVolume& v, size_t max_labels) {
+LabelTable label_table_part(const ScalarVolume& v, const Box& read, const Box& core, const std::array<int64_t, 3>& n,
+                            size_t max_labels) {
+  if (v.lattice.dims != read.dims()) throw std::logic_error("label_table_part: the samples are not the read box");
+  for (size_t a = 0; a < 3; ++a)
+    if (core.lo[a] < read.lo[a] || core.hi[a] > read.hi[a] || (core.lo[a] > 0 && read.lo[a] >= core.lo[a]))
+      throw std::logic_error("label_table_part: the read box must hold the core and one sample below it");
   LabelTable t;
   t.layered = v.components > 1;
   for (int64_t layer = 0; layer < v.components; ++layer) {
     LayerScan scan = v.visit([&](auto values) {
       using T = typename decltype(values)::value_type;
-      return scan_layer<T>(v, values, layer, max_labels, v.components == 1);
+      return scan_layer<T>(v, values, layer, max_labels, v.components == 1, read, core, n);
     });
     for (LabelInfo& l : scan.labels) t.labels.push_back(std::move(l));
     if (v.components == 1) t.contacts = std::move(scan.contacts);
   }
-  std::sort(t.labels.begin(), t.labels.end(), [](const LabelInfo& a, const LabelInfo& b) {
-    return std::tie(a.layer, a.value) < std::tie(b.layer, b.value);
-  });
+  return t;
+}
+
+LabelTable merge_label_tables(const std::vector<LabelTable>& parts, const ScalarVolume& header, size_t max_labels) {
+  // Labels by (layer, value) and contacts by (a, b): sums, minima, maxima;
+  // the result does not depend on the parts' order.
+  std::map<std::pair<int64_t, double>, LabelInfo> labels;
+  std::map<std::pair<double, double>, uint64_t> contacts;
+  LabelTable t;
+  t.layered = header.components > 1;
+  for (const LabelTable& part : parts) {
+    for (const LabelInfo& l : part.labels) {
+      auto [it, fresh] = labels.try_emplace({l.layer, l.value}, l);
+      if (fresh) continue;
+      LabelInfo& m = it->second;
+      m.samples += l.samples;
+      for (size_t a = 0; a < 3; ++a) {
+        m.lo[a] = std::min(m.lo[a], l.lo[a]);
+        m.hi[a] = std::max(m.hi[a], l.hi[a]);
+      }
+    }
+    for (const LabelContact& c : part.contacts) contacts[{c.a, c.b}] += c.sticks;
+  }
+  if (labels.size() > max_labels)
+    throw InputError(header.source, "more than " + std::to_string(max_labels) + " distinct labels");
+  for (auto& [key, l] : labels) t.labels.push_back(std::move(l));  // by layer, then value
+  for (const auto& [key, count] : contacts) t.contacts.push_back({key.first, key.second, count});
   // .seg.nrrd: the segments are the labels (a value no segment names is dropped).
-  if (!v.segments.empty()) {
+  if (!header.segments.empty()) {
     std::vector<LabelInfo> named;
-    for (const Segment& s : v.segments) {
+    for (const Segment& s : header.segments) {
       for (const LabelInfo& l : t.labels)
         if (l.layer == s.layer && l.value == s.label) {
           named.push_back(l);
@@ -169,8 +206,13 @@ LabelTable label_table(const ScalarVolume& v, size_t max_labels) {
     }
     t.labels = std::move(named);
   }
-  if (t.labels.empty()) throw InputError(v.source, "no labelled sample (every value is 0)");
+  if (t.labels.empty()) throw InputError(header.source, "no labelled sample (every value is 0)");
   return t;
+}
+
+LabelTable label_table(const ScalarVolume& v, size_t max_labels) {
+  const Box all{{0, 0, 0}, v.lattice.dims};
+  return merge_label_tables({label_table_part(v, all, all, v.lattice.dims, max_labels)}, v, max_labels);
 }
 
 std::vector<double> parse_label_list(const std::string& text) {
@@ -237,32 +279,78 @@ std::map<double, std::string> read_label_names(const std::string& path) {
   return names;
 }
 
-BinaryVolume label_mask(const ScalarVolume& v, const LabelInfo& label) {
+namespace {
+
+// The label's box grown by one sample, clipped to the lattice (inclusive).
+std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> mask_box(const Lattice& lattice, const LabelInfo& label) {
   std::array<int64_t, 3> lo{}, hi{};
   for (size_t a = 0; a < 3; ++a) {
     lo[a] = std::max<int64_t>(0, label.lo[a] - 1);
-    hi[a] = std::min<int64_t>(v.lattice.dims[a] - 1, label.hi[a] + 1);
+    hi[a] = std::min<int64_t>(lattice.dims[a] - 1, label.hi[a] + 1);
   }
+  return {lo, hi};
+}
+
+// An empty mask of the label's box, its lattice's origin at the box's corner.
+BinaryVolume empty_mask(const Lattice& lattice, const std::string& source, const LabelInfo& label) {
+  const auto [lo, hi] = mask_box(lattice, label);
   BinaryVolume b;
-  b.source = v.source;
-  b.lattice = v.lattice;
+  b.source = source;
+  b.lattice = lattice;
   b.lattice.dims = {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1};
-  b.lattice.origin = v.lattice.to_physical(Vec3(double(lo[0]), double(lo[1]), double(lo[2])));
+  b.lattice.origin = lattice.to_physical(Vec3(double(lo[0]), double(lo[1]), double(lo[2])));
   b.inside.assign(b.lattice.size(), 0);
+  return b;
+}
+
+// dst (laid out as `box` of v, x fastest) = whether v's samples in `box`
+// hold the label.
+void mask_into(const ScalarVolume& v, const Box& box, const LabelInfo& label, uint8_t* dst) {
   const uint64_t nc = uint64_t(v.components), layer = uint64_t(label.layer);
+  const auto d = box.dims();
   v.visit([&](auto values) {
     using T = typename decltype(values)::value_type;
     const T want = T(label.value);
-    const auto& d = b.lattice.dims;
     tbb::parallel_for(int64_t(0), d[2], [&](int64_t k) {
       for (int64_t j = 0; j < d[1]; ++j)
         for (int64_t i = 0; i < d[0]; ++i) {
-          const uint64_t s = v.lattice.linear(lo[0] + i, lo[1] + j, lo[2] + k);
-          b.inside[b.lattice.linear(i, j, k)] = values[size_t(s * nc + layer)] == want;
+          const uint64_t s = v.lattice.linear(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
+          dst[size_t(i + d[0] * (j + d[1] * k))] = values[size_t(s * nc + layer)] == want;
         }
     });
   });
+}
+
+constexpr uint64_t kSlabSamples = uint64_t(1) << 24;  // a box is read this many samples at a time (16 Mi)
+
+}  // namespace
+
+BinaryVolume label_mask(const ScalarVolume& v, const LabelInfo& label) {
+  BinaryVolume b = empty_mask(v.lattice, v.source, label);
+  const auto [lo, hi] = mask_box(v.lattice, label);
+  mask_into(v, Box{lo, {hi[0] + 1, hi[1] + 1, hi[2] + 1}}, label, b.inside.data());
   return b;
+}
+
+LabelMasks masks_in(const ScalarVolume& volume) {
+  return [&volume](const LabelInfo& label) { return label_mask(volume, label); };
+}
+
+LabelMasks masks_read(const Lattice& lattice, const std::string& source, BoxRead read) {
+  return [lattice, source, read = std::move(read)](const LabelInfo& label) {
+    BinaryVolume b = empty_mask(lattice, source, label);
+    const auto [lo, hi] = mask_box(lattice, label);
+    const auto& d = b.lattice.dims;
+    const int64_t planes = std::max<int64_t>(1, int64_t(kSlabSamples / uint64_t(d[0] * d[1])));
+    for (int64_t k0 = lo[2]; k0 <= hi[2]; k0 += planes) {
+      const int64_t k1 = std::min(hi[2] + 1, k0 + planes);
+      const ScalarVolume slab = read(Box{{lo[0], lo[1], k0}, {hi[0] + 1, hi[1] + 1, k1}});
+      if (slab.lattice.dims != std::array<int64_t, 3>{d[0], d[1], k1 - k0})
+        throw std::logic_error("masks_read: the reader returned the wrong box");
+      mask_into(slab, Box{{0, 0, 0}, slab.lattice.dims}, label, b.inside.data() + size_t(d[0] * d[1] * (k0 - lo[2])));
+    }
+    return b;
+  };
 }
 
 std::vector<LabelSurface> press_labels(const ScalarVolume& v, const std::vector<LabelInfo>& labels,

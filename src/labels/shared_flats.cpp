@@ -34,7 +34,7 @@ size_t SharedFlats::flats_of(double value) const {
   return size_t(std::count(flat_label.begin(), flat_label.end(), uint32_t(value)));
 }
 
-SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s, const std::vector<LabelInfo>& labels,
+SharedFlats find_shared_flats(const LabelMasks& masks, const SharedSurface& s, const std::vector<LabelInfo>& labels,
                               const PressOptions& press, const FlatOptions& options, Progress* progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = s.mesh.positions.size();
@@ -44,7 +44,7 @@ SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s
   out.region.assign(n, -1);
   // The shared stick vertices by global stick key (lower sample padded),
   // for the labels' lookups.
-  const auto& dims = volume.lattice.dims;
+  const auto& dims = s.lattice.dims;
   auto key = [&](const std::array<int64_t, 3>& lower, int axis) {
     return stick_key(dims, {lower[0] + 1, lower[1] + 1, lower[2] + 1}, axis);
   };
@@ -62,7 +62,7 @@ SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& s
   std::atomic<uint64_t> done{0};
   tbb::parallel_for(size_t(0), labels.size(), [&](size_t i) {
     const LabelInfo& label = labels[i];
-    const BinaryVolume mask = label_mask(volume, label);
+    const BinaryVolume mask = masks(label);
     const std::array<int64_t, 3> lo = {std::max<int64_t>(0, label.lo[0] - 1), std::max<int64_t>(0, label.lo[1] - 1),
                                        std::max<int64_t>(0, label.lo[2] - 1)};
     StickSurface surface = extract_sticks(mask);

@@ -448,17 +448,26 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
 }
 
 SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& o) {
-  require_float32_room(volume.lattice, o, volume.source);
-  SharedLabels r;
+  require_float32_room(volume.lattice, o, volume.source);  // before the extraction's cost
   const auto t0 = std::chrono::steady_clock::now();
-  r.surface = extract_shared_surface(volume);
-  r.seconds_extract = detail::seconds_since(t0);
+  SharedSurface surface = extract_shared_surface(volume);
+  const double seconds = detail::seconds_since(t0);
+  SharedLabels r = press_shared_labels(std::move(surface), masks_in(volume), table, o, volume.source);
+  r.seconds_extract = seconds;
+  return r;
+}
+
+SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks, const LabelTable& table,
+                                 const SurfaceOptions& o, const std::string& source) {
+  require_float32_room(surface.lattice, o, source);
+  SharedLabels r;
+  r.surface = std::move(surface);
   PressOptions po = o.press;
   o.overrides.apply(po);
   if (o.passes.on(Pass::flats)) {
     FlatOptions fo = o.flat;
     fo.passes = o.passes;
-    r.flats = find_shared_flats(volume, r.surface, table.labels, po, fo, o.progress);
+    r.flats = find_shared_flats(masks, r.surface, table.labels, po, fo, o.progress);
   }
   r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr);
   return r;

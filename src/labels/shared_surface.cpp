@@ -37,18 +37,13 @@ struct Keys {
   }
 };
 
-struct Emitted {
-  std::array<uint64_t, 3> keys;
-  uint32_t in, out;
-};
-
 }  // namespace
 
-SharedSurface extract_shared_surface(const ScalarVolume& volume) {
+SharedPiece extract_shared_piece(const ScalarVolume& volume, const Box& read, const Box& core,
+                                 const std::array<int64_t, 3>& n) {
   if (volume.components != 1) throw InputError(volume.source, "a label map has one value per sample");
-  volume.lattice.validate();
-  const auto& n = volume.lattice.dims;
-  // Sample labels, validated, and the label values present.
+  if (volume.lattice.dims != read.dims()) throw std::logic_error("extract_shared_piece: the samples are not the read box");
+  // Sample labels, validated.
   std::vector<uint32_t> lab(volume.lattice.size());
   std::atomic<bool> bad{false};
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, lab.size(), 1 << 16), [&](const tbb::blocked_range<uint64_t>& r) {
@@ -59,37 +54,25 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
     }
   });
   if (bad) throw InputError(volume.source, "a label map holds whole numbers from 0 to 2^32 - 1 (found another value)");
-  SharedSurface out;
-  out.lattice = volume.lattice;
-  {
-    std::vector<uint32_t> values = lab;
-    tbb::parallel_sort(values.begin(), values.end());
-    values.erase(std::unique(values.begin(), values.end()), values.end());
-    if (values.size() < 2 && (values.empty() || values[0] == 0))
-      throw InputError(volume.source, "the volume is empty: every sample is the background, 0");
-    if (values[0] != 0) values.insert(values.begin(), 0u);  // beyond the lattice is background
-    out.labels = std::move(values);
-  }
-  auto index_of = [&](uint32_t value) {
-    return uint32_t(std::lower_bound(out.labels.begin(), out.labels.end(), value) - out.labels.begin());
-  };
-  auto at = [&](int64_t i, int64_t j, int64_t k) -> uint32_t {  // unpadded; background beyond
+  const auto& rd = read.dims();
+  auto at = [&](int64_t i, int64_t j, int64_t k) -> uint32_t {  // unpadded, whole volume; background beyond
     if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) return 0;
-    return lab[volume.lattice.linear(i, j, k)];
+    return lab[size_t((i - read.lo[0]) + rd[0] * ((j - read.lo[1]) + rd[1] * (k - read.lo[2])))];
   };
   const Keys keys{uint64_t(n[0] + 2), uint64_t(n[1] + 2)};
-
-  // Cubes by padded lower corner (p, q, r) in [0, n]: one layer per r.
-  std::vector<std::vector<Emitted>> layers(size_t(n[2] + 1));
-  std::mutex apex_mutex;
-  std::vector<std::pair<uint64_t, Vec3>> apex_positions;
-  std::string underivable;
-  tbb::parallel_for(tbb::blocked_range<int64_t>(0, n[2] + 1, 1), [&](const tbb::blocked_range<int64_t>& rr) {
-    std::vector<std::pair<uint64_t, Vec3>> apexes;
+  // Owned cubes by padded lower corner (p, q, r) in [0, n]: the unpadded
+  // corner p - 1, clamped into the volume, lies in the core.
+  std::array<int64_t, 3> first{}, last{};
+  for (size_t a = 0; a < 3; ++a) {
+    first[a] = core.lo[a] == 0 ? 0 : core.lo[a] + 1;
+    last[a] = core.hi[a];
+  }
+  std::vector<SharedPiece> layers(size_t(last[2] - first[2] + 1));
+  tbb::parallel_for(tbb::blocked_range<int64_t>(first[2], last[2] + 1, 1), [&](const tbb::blocked_range<int64_t>& rr) {
     for (int64_t r = rr.begin(); r < rr.end(); ++r) {
-      auto& emitted = layers[size_t(r)];
-      for (int64_t q = 0; q <= n[1]; ++q)
-        for (int64_t p = 0; p <= n[0]; ++p) {
+      SharedPiece& out = layers[size_t(r - first[2])];
+      for (int64_t q = first[1]; q <= last[1]; ++q)
+        for (int64_t p = first[0]; p <= last[0]; ++p) {
           std::array<uint32_t, 8> c;
           bool same = true;
           for (int k = 0; k < 8; ++k) {
@@ -97,6 +80,7 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
             same = same && c[size_t(k)] == c[0];
           }
           if (same) continue;
+          const uint64_t cube_id = uint64_t(p) + keys.px * (uint64_t(q) + keys.py * uint64_t(r));
           int distinct = 0;
           std::array<uint32_t, 8> value{};  // of each rank
           const LabelPattern pattern = label_pattern(c, &distinct, &value);
@@ -104,11 +88,12 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
           try {
             lc = &label_case(pattern);
           } catch (const std::logic_error&) {
-            std::lock_guard lock(apex_mutex);
-            if (underivable.empty())
-              underivable = "the cube at sample (" + std::to_string(p - 1) + ", " + std::to_string(q - 1) + ", " +
-                            std::to_string(r - 1) + ") joins " + std::to_string(distinct) +
-                            " labels in a way shared surfaces do not handle yet (issue 54)";
+            if (cube_id < out.underivable_cube) {
+              out.underivable_cube = cube_id;
+              out.underivable = "the cube at sample (" + std::to_string(p - 1) + ", " + std::to_string(q - 1) + ", " +
+                                std::to_string(r - 1) + ") joins " + std::to_string(distinct) +
+                                " labels in a way shared surfaces do not handle yet (issue 54)";
+            }
             continue;
           }
           const std::array<int64_t, 3> cube{p, q, r};
@@ -126,30 +111,99 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
             return keys.key(cube, uint64_t(6 + (v - kApex)));
           };
           for (size_t k = 0; k < lc->apexes.size(); ++k)
-            apexes.push_back({keys.key(cube, 6 + k), Vec3(double(p - 1), double(q - 1), double(r - 1)) + lc->apexes[k]});
-          for (const auto& t : lc->triangles)
-            emitted.push_back({{vertex_key(t.v[0]), vertex_key(t.v[1]), vertex_key(t.v[2])},
-                               index_of(value[t.in]), index_of(value[t.out])});
+            out.apexes.push_back(
+                {keys.key(cube, 6 + k), Vec3(double(p - 1), double(q - 1), double(r - 1)) + lc->apexes[k]});
+          for (const auto& t : lc->triangles) {
+            out.cube.push_back(cube_id);
+            out.keys.push_back({vertex_key(t.v[0]), vertex_key(t.v[1]), vertex_key(t.v[2])});
+            out.values.push_back({value[t.in], value[t.out]});
+          }
         }
     }
-    std::lock_guard lock(apex_mutex);
-    apex_positions.insert(apex_positions.end(), apexes.begin(), apexes.end());
   });
-  if (!underivable.empty()) throw InputError(volume.source, underivable);
+  // The layers in order, into one piece.
+  SharedPiece out;
+  size_t m = 0, a = 0;
+  for (const SharedPiece& l : layers) m += l.cube.size(), a += l.apexes.size();
+  out.cube.reserve(m);
+  out.keys.reserve(m);
+  out.values.reserve(m);
+  out.apexes.reserve(a);
+  for (SharedPiece& l : layers) {
+    out.cube.insert(out.cube.end(), l.cube.begin(), l.cube.end());
+    out.keys.insert(out.keys.end(), l.keys.begin(), l.keys.end());
+    out.values.insert(out.values.end(), l.values.begin(), l.values.end());
+    out.apexes.insert(out.apexes.end(), l.apexes.begin(), l.apexes.end());
+    if (l.underivable_cube < out.underivable_cube) {
+      out.underivable_cube = l.underivable_cube;
+      out.underivable = std::move(l.underivable);
+    }
+    l = SharedPiece{};
+  }
+  return out;
+}
+
+SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<SharedPiece> pieces,
+                                      const std::string& source) {
+  const auto& n = lattice.dims;
+  const Keys keys{uint64_t(n[0] + 2), uint64_t(n[1] + 2)};
+  const SharedPiece* worst = nullptr;
+  for (const SharedPiece& p : pieces)
+    if (p.underivable_cube != UINT64_MAX && (!worst || p.underivable_cube < worst->underivable_cube)) worst = &p;
+  if (worst) throw InputError(source, worst->underivable);
+
+  // Triangles in cube order: a cube's triangles all come from one piece,
+  // consecutive, so (cube, place in the concatenation) is a total order.
+  size_t m = 0;
+  for (const SharedPiece& p : pieces) m += p.cube.size();
+  std::vector<std::pair<uint64_t, uint64_t>> order;  // (cube, piece << 40 | index)
+  bool sorted = true;
+  if (pieces.size() > 1) {
+    order.reserve(m);
+    for (size_t p = 0; p < pieces.size(); ++p)
+      for (size_t i = 0; i < pieces[p].cube.size(); ++i) order.push_back({pieces[p].cube[i], (uint64_t(p) << 40) | i});
+    tbb::parallel_sort(order.begin(), order.end());
+    sorted = false;
+  }
+  auto tri = [&](size_t i) -> std::pair<const SharedPiece*, size_t> {
+    if (sorted) return {&pieces[0], i};
+    const uint64_t ref = order[i].second;
+    return {&pieces[size_t(ref >> 40)], size_t(ref & ((uint64_t(1) << 40) - 1))};
+  };
+
+  SharedSurface out;
+  out.lattice = lattice;
+  {
+    std::vector<uint32_t> values;
+    values.reserve(2 * m);
+    for (const SharedPiece& p : pieces)
+      for (const auto& v : p.values) values.insert(values.end(), v.begin(), v.end());
+    tbb::parallel_sort(values.begin(), values.end());
+    values.erase(std::unique(values.begin(), values.end()), values.end());
+    if (values.empty()) throw InputError(source, "the volume is empty: every sample is the background, 0");
+    if (values[0] != 0) values.insert(values.begin(), 0u);  // beyond the lattice is background
+    out.labels = std::move(values);
+  }
+  auto index_of = [&](uint32_t value) {
+    return uint32_t(std::lower_bound(out.labels.begin(), out.labels.end(), value) - out.labels.begin());
+  };
 
   // Vertices: the keys in increasing order.
-  size_t m = 0;
-  for (const auto& l : layers) m += l.size();
   std::vector<uint64_t> all;
   all.reserve(3 * m);
-  for (const auto& l : layers)
-    for (const Emitted& e : l) all.insert(all.end(), e.keys.begin(), e.keys.end());
+  for (const SharedPiece& p : pieces)
+    for (const auto& k : p.keys) all.insert(all.end(), k.begin(), k.end());
   tbb::parallel_sort(all.begin(), all.end());
   all.erase(std::unique(all.begin(), all.end()), all.end());
-  if (all.size() >= UINT32_MAX) throw LimitError(volume.source, "more than 2^32 - 1 vertices");
+  if (all.size() >= UINT32_MAX) throw LimitError(source, "more than 2^32 - 1 vertices");
+  std::vector<std::pair<uint64_t, Vec3>> apex_positions;
+  for (SharedPiece& p : pieces) {
+    apex_positions.insert(apex_positions.end(), p.apexes.begin(), p.apexes.end());
+    p.apexes = {};
+  }
   tbb::parallel_sort(apex_positions.begin(), apex_positions.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
-  const Mat3 M = volume.lattice.index_to_physical_matrix();
+  const Mat3 M = lattice.index_to_physical_matrix();
   out.mesh.positions.resize(all.size());
   out.kind.resize(all.size());
   out.corner.resize(all.size());
@@ -169,7 +223,7 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
                                          [](const auto& e, uint64_t k) { return e.first < k; });
         x = it->second;
       }
-      out.mesh.positions[i] = volume.lattice.origin + M * x;
+      out.mesh.positions[i] = lattice.origin + M * x;
     }
   });
   for (uint64_t key : all) {
@@ -179,22 +233,28 @@ SharedSurface extract_shared_surface(const ScalarVolume& volume) {
   // Triangles in cube order, the keys looked up.
   out.mesh.triangles.resize(m);
   out.sides.resize(m);
-  const bool flip = volume.lattice.flips_orientation();
-  size_t base = 0;
-  for (const auto& l : layers) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, l.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) {
-        Triangle t;
-        for (int v = 0; v < 3; ++v)
-          t[size_t(v)] = uint32_t(std::lower_bound(all.begin(), all.end(), l[i].keys[size_t(v)]) - all.begin());
-        if (flip) std::swap(t[1], t[2]);
-        out.mesh.triangles[base + i] = t;
-        out.sides[base + i] = {l[i].in, l[i].out};
-      }
-    });
-    base += l.size();
-  }
+  const bool flip = lattice.flips_orientation();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const auto [piece, at] = tri(i);
+      Triangle t;
+      for (int v = 0; v < 3; ++v)
+        t[size_t(v)] = uint32_t(std::lower_bound(all.begin(), all.end(), piece->keys[at][size_t(v)]) - all.begin());
+      if (flip) std::swap(t[1], t[2]);
+      out.mesh.triangles[i] = t;
+      out.sides[i] = {index_of(piece->values[at][0]), index_of(piece->values[at][1])};
+    }
+  });
   return out;
+}
+
+SharedSurface extract_shared_surface(const ScalarVolume& volume) {
+  if (volume.components != 1) throw InputError(volume.source, "a label map has one value per sample");
+  volume.lattice.validate();
+  const Box all{{0, 0, 0}, volume.lattice.dims};
+  std::vector<SharedPiece> one;
+  one.push_back(extract_shared_piece(volume, all, all, volume.lattice.dims));
+  return assemble_shared_surface(volume.lattice, std::move(one), volume.source);
 }
 
 Mesh label_mesh(const SharedSurface& s, uint32_t label) {

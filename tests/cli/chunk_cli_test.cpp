@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "../labels/label_volumes.h"
 #include "test_util.h"
 
 namespace voxpress {
@@ -89,6 +90,42 @@ TEST(ChunkCli, SelectionsResolveOverTheWholeFileAndBadOptionsWriteNothing) {
   test::write_raw_volume(tmp.path("two.nrrd"), v);
   ASSERT_EQ(run_cli("-q press " + tmp.path("two.nrrd") + " --chunk 10 --halo 4 -o " + tmp.path("mask.ply"), &out), 0) << out;
   EXPECT_TRUE(test::read_file(tmp.path("two.ply")) == test::read_file(tmp.path("mask.ply")));
+}
+
+// press --labels --chunk: the label map streamed block by block writes the
+// in-memory run's files byte for byte (flats read from the file by label
+// box), each label checked; options that do not apply write nothing.
+TEST(ChunkCli, LabelMapsStreamToTheInMemoryBytes) {
+  test::TempDir tmp;
+  test::write_raw_volume(tmp.path("map.nrrd"), test::assembly(4).volume);  // two boxes: flats
+  const std::string in = tmp.path("map.nrrd");
+  std::string out;
+  ASSERT_EQ(run_cli("-q press " + in + " --labels all --check -o " + tmp.path("whole"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q press " + in + " --labels all --chunk 16 --check --stats-json " + tmp.path("s.json") + " -o " +
+                        tmp.path("blocks"),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json j = read_json(tmp.path("s.json"));
+  EXPECT_TRUE(j["chunks"]["streamed"].get<bool>());
+  EXPECT_EQ(j["chunks"]["blocks"].get<int>(), 64);
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(tmp.path("whole"))) {
+    const std::string name = e.path().filename().string();
+    EXPECT_TRUE(test::read_file(e.path().string()) == test::read_file(tmp.path("blocks/" + name))) << name;
+    ++files;
+  }
+  EXPECT_EQ(files, 4u);  // two labels, interfaces.ply, labels.json
+  size_t flats = 0;  // the box's faces: the flats' masks were read from the file
+  for (const auto& e : j["labels"]) {
+    EXPECT_EQ(e["checks"]["classification_violations"].get<uint64_t>(), 0u);
+    flats += e["flats"].get<size_t>();
+  }
+  EXPECT_GT(flats, 0u);
+  for (const char* bad : {" --chunk 8 --separate", " --chunk 8 --halo 2", " --chunk 8 --method taubin"}) {
+    EXPECT_EQ(run_cli("-q press " + in + " --labels all" + bad + " -o " + tmp.path("no"), &out), 2) << bad;
+    EXPECT_FALSE(std::filesystem::exists(tmp.path("no"))) << bad;
+  }
 }
 
 }  // namespace

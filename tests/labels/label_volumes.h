@@ -1,5 +1,6 @@
-// Label volumes shared by the label-map tests: an empty map, and a phantom
-// of nested and touching solids where three and four labels meet.
+// Label volumes shared by the label-map tests: an empty map, a phantom of
+// nested and touching solids where three and four labels meet, and an
+// assembly of two boxes (flats).
 #pragma once
 
 #include <cmath>
@@ -59,6 +60,35 @@ inline ScalarVolume checkerboard3(std::array<int64_t, 3> dims, int64_t j_step = 
     for (int64_t j = 0; j < dims[1]; ++j)
       for (int64_t i = 0; i < dims[0]; ++i) set(v, i, j, k, int((i + j_step * j + k) % 3) + first);
   return v;
+}
+
+// An assembly of two boxes sharing a face (labels 1 and 2), rotated,
+// anisotropic; its true surfaces are the two boxes'. Faces of 18-25 cells:
+// the detection needs more than the 12-16 of a 40^3 box (none found there).
+struct Assembly {
+  ScalarVolume volume;
+  Mat3 rotation;
+  Vec3 centre;
+  // Signed distance to box `label` (1 or 2), physical units.
+  double distance(int label, const Vec3& p) const {
+    const Vec3 q = rotation.transpose() * (p - centre) - 1.6 * Vec3(label == 1 ? -7 : 6, 0, 0);
+    const Vec3 h = 1.6 * (label == 1 ? Vec3(7, 8, 7) : Vec3(6, 7, 6));
+    const Vec3 d = q.cwiseAbs() - h;
+    return d.cwiseMax(0.0).norm() + std::min(d.maxCoeff(), 0.0);
+  }
+};
+inline Assembly assembly(int seed) {
+  Assembly a;
+  a.volume = label_volume({64, 64, 52}, {1, 1, 1.25});
+  a.rotation = parse_rotation("random:" + std::to_string(seed));
+  a.centre = a.volume.lattice.to_physical(Vec3(31.5, 31.5, 25.5));
+  for (int64_t k = 0; k < 52; ++k)
+    for (int64_t j = 0; j < 64; ++j)
+      for (int64_t i = 0; i < 64; ++i) {
+        const Vec3 p = a.volume.lattice.to_physical(Vec3(double(i), double(j), double(k)));
+        set(a.volume, i, j, k, a.distance(1, p) < 0 ? 1 : a.distance(2, p) < 0 ? 2 : 0);
+      }
+  return a;
 }
 
 }  // namespace voxpress::test

@@ -112,35 +112,6 @@ TEST(SharedPress, SixtyOneLabelMap) {
   }
 }
 
-// An assembly of two boxes sharing a face (labels 1 and 2), rotated,
-// anisotropic; its true surfaces are the two boxes'. Faces of 18-25 cells:
-// the detection needs more than the 12-16 of a 40^3 box (none found there).
-struct Assembly {
-  ScalarVolume volume;
-  Mat3 rotation;
-  Vec3 centre;
-  // Signed distance to box `label` (1 or 2), physical units.
-  double distance(int label, const Vec3& p) const {
-    const Vec3 q = rotation.transpose() * (p - centre) - 1.6 * Vec3(label == 1 ? -7 : 6, 0, 0);
-    const Vec3 h = 1.6 * (label == 1 ? Vec3(7, 8, 7) : Vec3(6, 7, 6));
-    const Vec3 d = q.cwiseAbs() - h;
-    return d.cwiseMax(0.0).norm() + std::min(d.maxCoeff(), 0.0);
-  }
-};
-Assembly assembly(int seed) {
-  Assembly a;
-  a.volume = test::label_volume({64, 64, 52}, {1, 1, 1.25});
-  a.rotation = parse_rotation("random:" + std::to_string(seed));
-  a.centre = a.volume.lattice.to_physical(Vec3(31.5, 31.5, 25.5));
-  for (int64_t k = 0; k < 52; ++k)
-    for (int64_t j = 0; j < 64; ++j)
-      for (int64_t i = 0; i < 64; ++i) {
-        const Vec3 p = a.volume.lattice.to_physical(Vec3(double(i), double(j), double(k)));
-        test::set(a.volume, i, j, k, a.distance(1, p) < 0 ? 1 : a.distance(2, p) < 0 ? 2 : 0);
-      }
-  return a;
-}
-
 // Issue 54, item 4: the shared surface of a CAD assembly gets its flats.
 // Over rotations: each box's faces are found (its own six, the shared face
 // seen from both sides), every label keeps every guarantee, and each label
@@ -148,11 +119,11 @@ Assembly assembly(int seed) {
 TEST(SharedPress, AssemblyOfBoxesGetsItsFlats) {
   for (int seed : {1, 2, 3}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    const Assembly a = assembly(seed);
+    const test::Assembly a = test::assembly(seed);
     const SharedSurface mid = extract_shared_surface(a.volume);
     SharedSurface plain = mid, flat = mid;
     press_shared(plain);
-    const SharedFlats f = find_shared_flats(a.volume, flat, label_table(a.volume).labels, PressOptions{}, FlatOptions{});
+    const SharedFlats f = find_shared_flats(masks_in(a.volume), flat, label_table(a.volume).labels, PressOptions{}, FlatOptions{});
     for (uint32_t value : {1u, 2u})
       EXPECT_GE(f.flats_of(value), 5u) << "label " << value;
     const SharedPressStats st = press_shared(flat, PressOptions{}, &f);
@@ -181,14 +152,14 @@ TEST(SharedPress, SameBytesForOneAndManyThreads) {
   press_shared(many);
   EXPECT_EQ(one.mesh.positions, many.mesh.positions);
   // With flats (found per label in parallel).
-  const ScalarVolume boxes = assembly(4).volume;
+  const ScalarVolume boxes = test::assembly(4).volume;
   SharedSurface a = extract_shared_surface(boxes), b = a;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    const SharedFlats f = find_shared_flats(boxes, a, label_table(boxes).labels, PressOptions{}, FlatOptions{});
+    const SharedFlats f = find_shared_flats(masks_in(boxes), a, label_table(boxes).labels, PressOptions{}, FlatOptions{});
     press_shared(a, PressOptions{}, &f);
   }
-  const SharedFlats f = find_shared_flats(boxes, b, label_table(boxes).labels, PressOptions{}, FlatOptions{});
+  const SharedFlats f = find_shared_flats(masks_in(boxes), b, label_table(boxes).labels, PressOptions{}, FlatOptions{});
   EXPECT_GT(f.frozen, 0u);
   press_shared(b, PressOptions{}, &f);
   EXPECT_EQ(a.mesh.positions, b.mesh.positions);

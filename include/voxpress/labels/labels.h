@@ -20,6 +20,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -57,6 +58,20 @@ struct LabelTable {
 /// volume.source) when there is no label or more than max_labels.
 LabelTable label_table(const ScalarVolume& volume, size_t max_labels = 65535);
 
+/// Block by block (press --labels --chunk): what the box `read` of a volume
+/// whose dims are `dims` contributes to its table (`samples` holds that box,
+/// which holds `core` and one sample below it where there is one): counts
+/// and boxes of the core's samples, contacts of the lattice edges whose
+/// upper sample is in the core.
+LabelTable label_table_part(const ScalarVolume& samples, const Box& read, const Box& core,
+                            const std::array<int64_t, 3>& dims, size_t max_labels = 65535);
+
+/// The table of parts that tile the volume (any order), named from the
+/// header's segments: label_table(v) is this of one part holding every
+/// sample. Throws InputError (naming header.source) as label_table does.
+LabelTable merge_label_tables(const std::vector<LabelTable>& parts, const ScalarVolume& header,
+                              size_t max_labels = 65535);
+
 /// The values of the CLI form "1,5,7"; "all" gives none (every label).
 /// Throws UsageError for anything else.
 std::vector<double> parse_label_list(const std::string& text);
@@ -77,6 +92,16 @@ std::map<double, std::string> read_label_names(const std::string& path);
 /// sample on each side (clipped to the lattice), with the lattice's origin
 /// moved to the box's corner: physical positions are unchanged.
 BinaryVolume label_mask(const ScalarVolume& volume, const LabelInfo& label);
+
+/// Where each label's mask comes from (flats of the shared surface, --check).
+using LabelMasks = std::function<BinaryVolume(const LabelInfo&)>;
+/// label_mask of a volume in memory (which must outlive the result).
+LabelMasks masks_in(const ScalarVolume& volume);
+/// The same masks read from a file box by box: `read` returns the samples
+/// of a box of `lattice` (VolumeFile::read), asked for slabs of planes, so
+/// a mask costs its box's samples in bytes, not the volume's values.
+using BoxRead = std::function<ScalarVolume(const Box&)>;
+LabelMasks masks_read(const Lattice& lattice, const std::string& source, BoxRead read);
 
 struct LabelSurface {
   LabelInfo label;

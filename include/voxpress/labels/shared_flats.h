@@ -38,9 +38,10 @@ struct SharedFlats {
 };
 
 /// The flats of every label of `labels` (label_table(volume).labels: their
-/// boxes) mapped onto the shared vertices of `surface`, extracted from
-/// `volume`. Labels in parallel; deterministic for any thread count.
-SharedFlats find_shared_flats(const ScalarVolume& volume, const SharedSurface& surface,
+/// boxes) mapped onto the shared vertices of `surface`, each label's mask
+/// from `masks` (masks_in(volume), or masks_read of a file). Labels in
+/// parallel; deterministic for any thread count.
+SharedFlats find_shared_flats(const LabelMasks& masks, const SharedSurface& surface,
                               const std::vector<LabelInfo>& labels, const PressOptions& press,
                               const FlatOptions& flats, Progress* progress = nullptr);
 

@@ -70,5 +70,9 @@ struct SharedLabels {
   double seconds_extract = 0;
 };
 SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& options);
+/// The same on a shared surface already extracted from `source` (press --labels --chunk
+/// assembles it from blocks), each label's mask for its flats from `masks`.
+SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks, const LabelTable& table,
+                                 const SurfaceOptions& options, const std::string& source);
 
 }  // namespace voxpress

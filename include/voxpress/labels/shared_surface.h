@@ -16,6 +16,8 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "voxpress/core/mesh.h"
@@ -41,8 +43,35 @@ struct SharedSurface {
 /// one component). Deterministic for any thread count. Throws InputError
 /// (naming volume.source) for fractional or negative values, a volume with
 /// a single value, or a cube whose labelling has no derived case yet (some
-/// cubes of four or more labels; the error names the cube).
+/// cubes of four or more labels; the error names the lowest such cube).
+/// The same as assemble_shared_surface of one piece holding every cube.
 SharedSurface extract_shared_surface(const ScalarVolume& volume);
+
+/// What the cubes of one block of a label map contribute (press --labels
+/// --chunk): their triangles, vertices named by global keys (padded sample
+/// and kind, so neighbouring blocks name a shared vertex alike), in cube
+/// order.
+struct SharedPiece {
+  std::vector<uint64_t> cube;                   ///< per triangle: padded linear index of its cube
+  std::vector<std::array<uint64_t, 3>> keys;    ///< per triangle: its vertices' keys
+  std::vector<std::array<uint32_t, 2>> values;  ///< per triangle: (in, out) label values
+  std::vector<std::pair<uint64_t, Vec3>> apexes;  ///< key and index-space position of each apex
+  std::string underivable;  ///< the lowest cube without a derived case (empty: none)
+  uint64_t underivable_cube = UINT64_MAX;
+};
+
+/// The piece of the cubes whose lower corner, clamped into the volume,
+/// lies in `core` (samples of the whole volume, whose dims are `dims`):
+/// `samples` holds the box `read` (core grown by one sample, clipped).
+/// Throws InputError for samples that are not labels.
+SharedPiece extract_shared_piece(const ScalarVolume& samples, const Box& read, const Box& core,
+                                 const std::array<int64_t, 3>& dims);
+
+/// The shared surface of pieces that together cover every cube once, in
+/// any order: the same bytes as extract_shared_surface of the whole volume.
+/// `source` names the volume in errors.
+SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<SharedPiece> pieces,
+                                      const std::string& source);
 
 /// The closed, outward surface of label index `label` (its triangles, the
 /// ones it is `out` of reversed), vertices renumbered in order of the
