@@ -7,7 +7,11 @@ markdown table: wall time, peak RSS, labels, triangles of the interfaces,
 and whether every output file is the same bytes as the in-memory run's.
 
     VOXPRESS_CLI=build/bin/voxpress PYTHONPATH=build/python \
-        python3 bench/chunk_labels.py [--tiles 2] [--chunk 128] [--threads 2]
+        python3 bench/chunk_labels.py [--tiles 2] [--chunk 128] [--threads 2] [--dask]
+
+--dask adds voxpress.press_labels in process and voxpress.dask.press_labels
+on a LocalCluster of 1 and 2 worker processes (one thread each): time and
+whether every label's mesh has the in-process bytes.
 """
 import argparse
 import filecmp
@@ -38,11 +42,43 @@ def write_raw_nrrd(path, data, spacing, origin):
         f.write(np.ascontiguousarray(data.astype("<u2").T).tobytes())
 
 
+def dask_rows(tiled, lattice, args):
+    """In-process press_labels against voxpress.dask.press_labels on worker processes."""
+    import time
+
+    import dask.array as da
+    import distributed
+    import voxpress
+    import voxpress.dask
+
+    kw = dict(spacing=tuple(lattice.spacing), origin=tuple(lattice.origin))
+    t = time.perf_counter()
+    ref = voxpress.press_labels(tiled, **kw)
+    rows = [f"| in-process `press_labels`, all cores | {time.perf_counter() - t:.1f} s | |"]
+    for workers in (1, 2):
+        with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+            array = da.from_array(tiled, chunks=args.chunk)
+            t = time.perf_counter()
+            got = voxpress.dask.press_labels(array, chunk=args.chunk, client=client, threads=1, **kw)
+            s = time.perf_counter() - t
+        same = sorted(got) == sorted(ref) and all(
+            (got[k].vertices == ref[k].vertices).all() and (got[k].faces == ref[k].faces).all() for k in ref)
+        rows.append(f"| `voxpress.dask.press_labels`, {workers} worker process(es) of 1 thread | {s:.1f} s | "
+                    f"{'yes' if same else 'NO'} |")
+        print(rows[-1], file=sys.stderr, flush=True)
+    print(f"\nDask, blocks of {args.chunk}:\n")
+    print("| run | time | same bytes as in-process |")
+    print("|---|---:|---|")
+    print("\n".join(rows))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--tiles", type=int, default=2)
     ap.add_argument("--chunk", type=int, default=128)
     ap.add_argument("--threads", default="2")
+    ap.add_argument("--dask", action="store_true")
     args = ap.parse_args()
     if not MAP.exists():
         sys.exit(f"{MAP} is absent (../shared/data)")
@@ -87,6 +123,8 @@ def main():
         print("| run | time | peak RSS | labels | interface triangles | same bytes as in memory |")
         print("|---|---:|---:|---:|---:|---|")
         print("\n".join(rows))
+        if args.dask:
+            dask_rows(tiled, lattice, args)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -8,6 +8,7 @@
 #include <tbb/task_arena.h>
 
 #include <cstring>
+#include <optional>
 
 #include "py_common.h"
 
@@ -172,6 +173,151 @@ PyMesh py_stitch(const py::list& pieces, const py::handle& shape, const py::obje
   return out;
 }
 
+// A label-map block's part of the table and piece of the shared surface
+// (voxpress.dask.press_labels), as numpy arrays that pickle compactly.
+py::dict py_label_block(const py::array& block_samples, const py::handle& shape, size_t block, int64_t chunk,
+                        int threads) {
+  const Corner dims = corner(shape, "shape");
+  const ChunkGrid grid(dims, ChunkOptions{chunk, 0});
+  if (block >= grid.count()) throw UsageError("block " + std::to_string(block) + " is not in the plan");
+  const Box read = grid.with_halo(block), core = grid.core(block);
+  ScalarVolume v = to_volume(block_samples, py::make_tuple(1, 1, 1), py::make_tuple(0, 0, 0), py::none(), "xyz");
+  v.source = "array";
+  if (v.lattice.dims != read.dims())
+    throw UsageError("block " + std::to_string(block) + " must be the array's box read = (lo, hi) of chunk_plan");
+  LabelTable t;
+  SharedPiece piece;
+  {
+    py::gil_scoped_release release;
+    auto run = [&] {
+      t = label_table_part(v, read, core, dims);
+      piece = extract_shared_piece(v, read, core, dims);
+    };
+    if (threads > 0) {
+      tbb::task_arena arena(threads);
+      arena.execute(run);
+    } else {
+      run();
+    }
+  }
+  std::vector<double> value, a, b;
+  std::vector<uint64_t> samples, sticks, apex_keys;
+  std::vector<int64_t> box;
+  for (const LabelInfo& l : t.labels) {
+    value.push_back(l.value);
+    samples.push_back(l.samples);
+    box.insert(box.end(), l.lo.begin(), l.lo.end());
+    box.insert(box.end(), l.hi.begin(), l.hi.end());
+  }
+  for (const LabelContact& c : t.contacts) a.push_back(c.a), b.push_back(c.b), sticks.push_back(c.sticks);
+  std::vector<uint64_t> keys;
+  std::vector<uint32_t> values;
+  std::vector<double> apex_pos;
+  for (size_t i = 0; i < piece.cube.size(); ++i) {
+    keys.insert(keys.end(), piece.keys[i].begin(), piece.keys[i].end());
+    values.insert(values.end(), piece.values[i].begin(), piece.values[i].end());
+  }
+  for (const auto& [key, x] : piece.apexes) {
+    apex_keys.push_back(key);
+    apex_pos.insert(apex_pos.end(), {x.x(), x.y(), x.z()});
+  }
+  py::dict d;
+  d["block"] = block;
+  d["value"] = to_numpy(value);
+  d["samples"] = to_numpy(samples);
+  d["box"] = to_numpy(box);
+  d["a"] = to_numpy(a);
+  d["b"] = to_numpy(b);
+  d["sticks"] = to_numpy(sticks);
+  d["cube"] = to_numpy(piece.cube);
+  d["keys"] = to_numpy(keys);
+  d["values"] = to_numpy(values);
+  d["apex_keys"] = to_numpy(apex_keys);
+  d["apex_pos"] = to_numpy(apex_pos);
+  d["underivable"] = piece.underivable;
+  d["underivable_cube"] = piece.underivable_cube;
+  return d;
+}
+
+std::pair<LabelTable, SharedPiece> label_block_from_dict(const py::dict& d) {
+  LabelTable t;
+  const auto value = from_numpy<double>(d, "value"), a = from_numpy<double>(d, "a"), b = from_numpy<double>(d, "b");
+  const auto samples = from_numpy<uint64_t>(d, "samples"), sticks = from_numpy<uint64_t>(d, "sticks");
+  const auto box = from_numpy<int64_t>(d, "box");
+  if (samples.size() != value.size() || box.size() != 6 * value.size() || b.size() != a.size() ||
+      sticks.size() != a.size())
+    throw UsageError("a label block's table arrays do not match (not from _label_block?)");
+  for (size_t i = 0; i < value.size(); ++i) {
+    LabelInfo l;
+    l.value = value[i];
+    l.samples = samples[i];
+    for (size_t k = 0; k < 3; ++k) l.lo[k] = box[6 * i + k], l.hi[k] = box[6 * i + 3 + k];
+    t.labels.push_back(l);
+  }
+  for (size_t i = 0; i < a.size(); ++i) t.contacts.push_back({a[i], b[i], sticks[i]});
+  SharedPiece p;
+  p.cube = from_numpy<uint64_t>(d, "cube");
+  const auto keys = from_numpy<uint64_t>(d, "keys"), apex_keys = from_numpy<uint64_t>(d, "apex_keys");
+  const auto values = from_numpy<uint32_t>(d, "values");
+  const auto apex_pos = from_numpy<double>(d, "apex_pos");
+  if (keys.size() != 3 * p.cube.size() || values.size() != 2 * p.cube.size() || apex_pos.size() != 3 * apex_keys.size())
+    throw UsageError("a label block's surface arrays do not match (not from _label_block?)");
+  for (size_t i = 0; i < p.cube.size(); ++i) {
+    p.keys.push_back({keys[3 * i], keys[3 * i + 1], keys[3 * i + 2]});
+    p.values.push_back({values[2 * i], values[2 * i + 1]});
+  }
+  for (size_t i = 0; i < apex_keys.size(); ++i)
+    p.apexes.push_back({apex_keys[i], Vec3(apex_pos[3 * i], apex_pos[3 * i + 1], apex_pos[3 * i + 2])});
+  if (d.contains("underivable")) p.underivable = d["underivable"].cast<std::string>();
+  if (d.contains("underivable_cube")) p.underivable_cube = d["underivable_cube"].cast<uint64_t>();
+  return {std::move(t), std::move(p)};
+}
+
+// Every block's part, merged and pressed as `press --labels --chunk`: the
+// table, the assembled shared surface, each label's flats on the mask of its
+// box (read(lo, hi) returns the label map's samples of that box).
+py::object py_press_label_blocks(const py::list& blocks, const py::handle& shape, const py::object& labels,
+                                 const py::function& read, const py::object& spacing, const py::object& origin,
+                                 const py::object& direction, bool interfaces, const py::kwargs& kw) {
+  SurfaceOptions o;
+  set_options(o, kw);
+  check_shared_options(kw);
+  const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
+  std::vector<LabelTable> parts;
+  std::vector<SharedPiece> pieces;
+  for (const py::handle& h : blocks) {
+    auto [t, p] = label_block_from_dict(h.cast<py::dict>());
+    parts.push_back(std::move(t));
+    pieces.push_back(std::move(p));
+  }
+  ScalarVolume header;
+  header.lattice = lattice;
+  header.source = "array";
+  const std::vector<double> values = label_values(labels);
+  // The label map's samples of a box, from Python (the GIL taken for it:
+  // flats run labels on several threads).
+  const BoxRead box_read = [&read](const Box& box) {
+    py::gil_scoped_acquire gil;
+    const py::array a = py::module_::import("numpy").attr("asarray")(read(py::cast(box.lo), py::cast(box.hi)));
+    ScalarVolume v = to_volume(a, py::make_tuple(1, 1, 1), py::make_tuple(0, 0, 0), py::none(), "xyz");
+    v.source = "array";
+    return v;
+  };
+  std::vector<LabelInfo> chosen;
+  std::vector<Mesh> meshes;
+  std::vector<size_t> flats;
+  std::optional<SharedLabels> r;
+  {
+    py::gil_scoped_release release;
+    const LabelTable table = merge_label_tables(parts, header);
+    chosen = select_labels(table, values, "array");
+    SharedSurface surface = assemble_shared_surface(lattice, std::move(pieces), "array");
+    r = press_shared_labels(std::move(surface), masks_read(lattice, "array", box_read), table, o, "array");
+    cut_labels(*r, chosen, meshes, flats);
+  }
+  return labels_result(chosen, std::move(meshes), flats, true, &*r, interfaces);
+}
+
 }  // namespace
 
 PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, const SurfaceOptions& o,
@@ -214,6 +360,16 @@ void bind_chunks(py::module_& m) {
         py::arg("direction") = py::none(), py::arg("smooth") = false,
         "The mesh of every block's piece (any order); smooth: the pieces were only extracted (halo 0), "
         "smooth the stitched sticks with the options (press()'s).");
+  m.def("_label_block", &py_label_block, py::arg("samples"), py::kw_only(), py::arg("shape"), py::arg("block"),
+        py::arg("chunk"), py::arg("threads") = 0,
+        "One label-map block's table part and shared-surface piece (voxpress.dask.press_labels); samples is the "
+        "block's read box of chunk_plan.");
+  m.def("_press_label_blocks", &py_press_label_blocks, py::arg("blocks"), py::kw_only(), py::arg("shape"),
+        py::arg("labels") = py::none(), py::arg("read"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
+        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(),
+        py::arg("interfaces") = false,
+        "press_labels() of every block's _label_block: {label: Mesh} (and the interfaces with interfaces=True); "
+        "read(lo, hi) returns the label map's samples of a box, for each label's flats.");
 }
 
 }  // namespace voxpress::python

@@ -31,7 +31,18 @@ Selection selection(const py::object& label, const py::object& threshold);
 /// press()'s keyword options (iterations, tolerance, flats, ...).
 void set_options(SurfaceOptions& o, const py::kwargs& kw);
 
-/// chunk_plan, _press_block, _stitch (chunk_py.cpp).
+/// press_labels()'s result: {label: Mesh}, and with `interfaces` (and a
+/// shared surface) the tuple ({label: Mesh}, the interfaces' Mesh).
+py::object labels_result(const std::vector<LabelInfo>& chosen, std::vector<Mesh> meshes, const std::vector<size_t>& flats,
+                         bool keeps, const SharedLabels* shared, bool interfaces);
+/// The chosen labels' closed meshes and flat counts, cut from the shared surface.
+void cut_labels(const SharedLabels& r, const std::vector<LabelInfo>& chosen, std::vector<Mesh>& meshes,
+                std::vector<size_t>& flats);
+/// UsageError for the sharpening options, which the shared surface has not.
+void check_shared_options(const py::kwargs& kw);
+/// labels=: None (every label) or the values.
+std::vector<double> label_values(const py::object& labels);
+/// chunk_plan, _press_block, _stitch, _label_block, _press_label_blocks (chunk_py.cpp).
 void bind_chunks(py::module_& m);
 /// press(..., chunk=N): press_chunked on the in-memory volume.
 PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, const SurfaceOptions& o,

@@ -235,6 +235,71 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
   return out;
 }
 
+}  // namespace
+
+namespace voxpress::python {
+
+py::object labels_result(const std::vector<LabelInfo>& chosen, std::vector<Mesh> meshes, const std::vector<size_t>& flats,
+                         bool keeps, const SharedLabels* shared, bool interfaces) {
+  py::dict out;
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    PyMesh m;
+    m.mesh = std::move(meshes[i]);
+    m.stats["label"] = chosen[i].value;
+    m.stats["samples"] = chosen[i].samples;
+    m.stats["vertices"] = m.mesh.vertex_count();
+    m.stats["triangles"] = m.mesh.face_count();
+    m.stats["flats"] = flats[i];
+    m.stats["shared"] = shared != nullptr;
+    m.stats["keeps_classification"] = keeps;
+    const double v = chosen[i].value;
+    if (v == std::floor(v) && std::abs(v) < 9e15)
+      out[py::int_(int64_t(v))] = std::move(m);
+    else
+      out[py::float_(v)] = std::move(m);
+  }
+  if (!interfaces || !shared) return out;
+  const SharedPressStats& ps = shared->press;
+  PyMesh all;
+  all.mesh = interfaces_mesh(shared->surface);
+  all.stats["junction_curves"] = ps.junction_curves;
+  all.stats["cubes_pinned"] = ps.cubes_pinned;
+  all.stats["cubes_reset"] = ps.cubes_reset;
+  all.stats["flats"] = shared->flats ? shared->flats->flats.size() : 0;
+  all.stats["flat_vertices"] = ps.flat_vertices;
+  all.stats["seconds"] = ps.seconds;
+  return py::make_tuple(out, all);
+}
+
+void cut_labels(const SharedLabels& r, const std::vector<LabelInfo>& chosen, std::vector<Mesh>& meshes,
+                std::vector<size_t>& flats) {
+  const SharedSurface& s = r.surface;
+  for (const LabelInfo& l : chosen) {
+    const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
+    meshes.push_back(label_mesh(s, uint32_t(it - s.labels.begin())));
+    flats.push_back(r.flats ? r.flats->flats_of(l.value) : 0);
+  }
+}
+
+void check_shared_options(const py::kwargs& kw) {
+  for (const char* k : {"sharpen", "sharp_angle", "color_regions", "fit_rings"})
+    if (kw.contains(k))
+      throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface is not sharpened)");
+}
+
+std::vector<double> label_values(const py::object& labels) {
+  std::vector<double> values;  // empty: every label
+  if (!labels.is_none()) {
+    for (const py::handle& h : labels) values.push_back(h.cast<double>());
+    if (values.empty()) throw UsageError("labels= selects no label");
+  }
+  return values;
+}
+
+}  // namespace voxpress::python
+
+namespace {
+
 // Every label of a label map: {value: Mesh}, as `press --labels` computes it.
 // {label: Mesh}: by default cut from one pressed shared surface (touching
 // labels share their interface vertex for vertex); separate=True, or a
@@ -247,38 +312,22 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
   o.method = parse_method(method);
   set_options(o, kw);
   const bool shared = !separate && o.method == Method::pressing;
-  if (shared)
-    for (const char* k : {"sharpen", "sharp_angle", "color_regions", "fit_rings"})
-      if (kw.contains(k))
-        throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface is not sharpened)");
+  if (shared) check_shared_options(kw);
   if (interfaces && !shared) throw UsageError("interfaces=True needs the shared surface (method='pressing', separate=False)");
   const py::array array = py::module_::import("numpy").attr("asarray")(array_like);
   const ScalarVolume scalar = to_volume(array, spacing, origin, direction, axes);
-  std::vector<double> values;  // empty: every label
-  if (!labels.is_none()) {
-    for (const py::handle& h : labels) values.push_back(h.cast<double>());
-    if (values.empty()) throw UsageError("labels= selects no label");
-  }
+  const std::vector<double> values = label_values(labels);
   std::vector<LabelInfo> chosen;
   std::vector<Mesh> meshes;
   std::vector<size_t> flats;
-  SharedSurface s;
-  SharedPressStats ps;
-  size_t shared_flats = 0;
+  std::optional<SharedLabels> r;
   {
     py::gil_scoped_release release;
     const LabelTable table = label_table(scalar);
     chosen = select_labels(table, values, scalar.source);
     if (shared && !table.layered) {
-      SharedLabels r = press_shared_labels(scalar, table, o);
-      s = std::move(r.surface);
-      ps = r.press;
-      for (const LabelInfo& l : chosen) {
-        const auto it = std::find(s.labels.begin(), s.labels.end(), uint32_t(l.value));
-        meshes.push_back(label_mesh(s, uint32_t(it - s.labels.begin())));
-        flats.push_back(r.flats ? r.flats->flats_of(l.value) : 0);
-      }
-      shared_flats = r.flats ? r.flats->flats.size() : 0;
+      r = press_shared_labels(scalar, table, o);
+      cut_labels(*r, chosen, meshes, flats);
     } else {
       for (LabelSurface& ls : press_labels(scalar, chosen, o)) {
         meshes.push_back(std::move(ls.result.mesh));
@@ -286,33 +335,8 @@ py::object py_press_labels(const py::object& array_like, const py::object& label
       }
     }
   }
-  py::dict out;
-  for (size_t i = 0; i < chosen.size(); ++i) {
-    PyMesh m;
-    m.mesh = std::move(meshes[i]);
-    m.stats["label"] = chosen[i].value;
-    m.stats["samples"] = chosen[i].samples;
-    m.stats["vertices"] = m.mesh.vertex_count();
-    m.stats["triangles"] = m.mesh.face_count();
-    m.stats["flats"] = flats[i];
-    m.stats["shared"] = shared;
-    m.stats["keeps_classification"] = keeps_classification(o.method);
-    const double v = chosen[i].value;
-    if (v == std::floor(v) && std::abs(v) < 9e15)
-      out[py::int_(int64_t(v))] = std::move(m);
-    else
-      out[py::float_(v)] = std::move(m);
-  }
-  if (!interfaces) return out;
-  PyMesh all;
-  all.mesh = interfaces_mesh(s);
-  all.stats["junction_curves"] = ps.junction_curves;
-  all.stats["cubes_pinned"] = ps.cubes_pinned;
-  all.stats["cubes_reset"] = ps.cubes_reset;
-  all.stats["flats"] = shared_flats;
-  all.stats["flat_vertices"] = ps.flat_vertices;
-  all.stats["seconds"] = ps.seconds;
-  return py::make_tuple(out, all);
+  return labels_result(chosen, std::move(meshes), flats, keeps_classification(o.method), r ? &*r : nullptr,
+                       interfaces);
 }
 
 // A volume argument of check/evaluate: a file path, or a mask array on a lattice.

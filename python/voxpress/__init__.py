@@ -72,11 +72,15 @@ def press_labels(array, labels=None, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
 
     array: integer label map (0 = background); labels: None for every
     non-zero value, or an iterable of values (an absent one raises
-    InputError). Each label is meshed on its bounding box, labels in
-    parallel; each mesh keeps its own label's samples inside and every other
-    sample outside. The labels' surfaces are independent (issue 54: shared
-    interfaces are not there yet). spacing, origin, direction, axes, method
-    and the options are press()'s.
+    InputError). By default every label is cut from one pressed shared
+    surface: touching labels share their interface vertex for vertex, each
+    mesh keeps its own label's samples inside and every other sample
+    outside; each label's flats are found (flats=False: none), there is no
+    sharpening. interfaces=True returns ({label: Mesh}, the shared surface
+    with face attributes label_in / label_out). separate=True (or a baseline
+    method) meshes each label alone on its box, with the whole feature
+    layer. spacing, origin, direction, axes, method and the options are
+    press()'s. voxpress.dask.press_labels does this block by block.
     """
     if "disable_passes" in options and options["disable_passes"] is not None:
         options["disable_passes"] = list(options["disable_passes"])

@@ -114,3 +114,52 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
         pieces = list(dask.compute(*tasks))
     return _voxpress._stitch(pieces, shape=shape, spacing=spacing, origin=origin, direction=direction,
                              smooth=not halo, **(options if not halo else {}))
+
+
+def _label_block(samples, **kw):
+    return _voxpress._label_block(np.asarray(samples), **kw)
+
+
+def press_labels(array, labels=None, *, chunk=256, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
+                 client=None, threads=0, interfaces=False, **options):
+    """Every label of a label map, block by block on Dask: voxpress.press_labels's result, byte for byte.
+
+    array: an integer label map (Dask, Zarr or numpy; array[i, j, k]),
+    0 the background. Each block (chunk samples per side, read with one
+    sample around it) is one task (voxpress._label_block on a worker)
+    returning its part of the label table and its piece of the shared
+    surface (global vertex keys: numpy arrays that pickle compactly). The
+    caller assembles the whole shared surface (`press --labels --chunk`),
+    reads each label's box from the array for its flats (flats=False skips
+    that), presses it and cuts {label: Mesh} from it; interfaces=True also
+    returns the shared surface with its label pairs. The caller holds the
+    surface, never the volume. labels, spacing, origin, direction and the
+    options are voxpress.press_labels's; client and threads as in press().
+    """
+    import dask
+    import dask.array as da
+
+    if not isinstance(array, da.Array):
+        if type(array).__module__.startswith("zarr"):
+            array = da.from_zarr(array)
+        else:
+            array = da.from_array(np.asarray(array), chunks=chunk)
+    if array.ndim != 3:
+        raise _voxpress.UsageError(f"the array must be 3-D (got {array.ndim} dimensions)")
+    shape = tuple(int(n) for n in array.shape)
+    block = dask.delayed(_label_block, pure=True)
+    tasks = []
+    for b in _voxpress.chunk_plan(shape, chunk=chunk):
+        (x0, y0, z0), (x1, y1, z1) = b["read"]
+        tasks.append(block(array[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, threads=threads))
+    parts = client.gather(client.compute(tasks)) if client is not None else list(dask.compute(*tasks))
+
+    def read(lo, hi):  # a label's box, for its flats
+        box = array[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
+        return np.asarray(client.compute(box).result() if client is not None else box.compute())
+
+    if "disable_passes" in options and options["disable_passes"] is not None:
+        options["disable_passes"] = list(options["disable_passes"])
+    return _voxpress._press_label_blocks(parts, shape=shape, labels=None if labels is None else list(labels), read=read,
+                                         spacing=spacing, origin=origin, direction=direction, interfaces=interfaces,
+                                         **{k: v for k, v in options.items() if v is not None})

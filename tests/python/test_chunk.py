@@ -92,3 +92,51 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
         voxpress.dask.press(da.zeros((32, 32, 32), chunks=16), chunk=16)
     with pytest.raises(voxpress.UsageError):
         voxpress.dask.press(labels, chunk=32, split_every=1)
+
+
+def label_phantom():
+    """A rotated box (1) with a sphere (2) pressed into it, a sphere (3) nested
+    in that one: three-label junctions, a flat box; anisotropic spacing."""
+    i, j, k = np.indices((56, 52, 40), dtype=np.float64)
+    x0, y0, z = i - 27.5, (j - 25.5) * 1.1, (k - 19.5) * 1.3
+    c, s = np.cos(0.35), np.sin(0.35)
+    x, y = c * x0 - s * y0, s * x0 + c * y0
+    out = np.zeros(i.shape, np.uint16)
+    out[(np.abs(x + 6) < 15) & (np.abs(y) < 13) & (np.abs(z) < 14)] = 1
+    r2 = (x - 9) ** 2 + y ** 2 + z ** 2
+    out[r2 < 13 ** 2] = 2
+    out[r2 < 5 ** 2] = 300
+    return out
+
+
+def test_dask_label_maps_give_press_labels_bytes():
+    pytest.importorskip("dask")
+    distributed = pytest.importorskip("distributed")
+    import dask.array as da
+
+    import voxpress.dask
+
+    vol = label_phantom()
+    spacing, origin = (1.0, 1.1, 1.3), (5.0, -2.0, 7.5)
+    ref, ref_all = voxpress.press_labels(vol, spacing=spacing, origin=origin, interfaces=True)
+    assert sorted(ref) == [1, 2, 300] and ref[1].stats["flats"] > 0  # the box's faces: masks read back from Dask
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        got, got_all = voxpress.dask.press_labels(da.from_array(vol, chunks=24), chunk=16, spacing=spacing,
+                                                  origin=origin, client=client, interfaces=True)
+    assert sorted(got) == sorted(ref)
+    for label, mesh in ref.items():
+        np.testing.assert_array_equal(got[label].vertices, mesh.vertices)
+        np.testing.assert_array_equal(got[label].faces, mesh.faces)
+        assert got[label].stats["flats"] == mesh.stats["flats"]
+    np.testing.assert_array_equal(got_all.vertices, ref_all.vertices)
+    np.testing.assert_array_equal(got_all.faces, ref_all.faces)
+    # The threaded scheduler, a selection, no flats: press_labels's bytes again.
+    some = voxpress.dask.press_labels(vol, labels=[300], chunk=20, flats=False)
+    alone = voxpress.press_labels(vol, labels=[300], flats=False)
+    assert list(some) == [300]
+    np.testing.assert_array_equal(some[300].vertices, alone[300].vertices)
+    with pytest.raises(voxpress.InputError):
+        voxpress.dask.press_labels(np.zeros((20, 20, 20), np.uint8), chunk=8)
+    with pytest.raises(voxpress.InputError):
+        voxpress.dask.press_labels(vol, labels=[7], chunk=32)
