@@ -85,6 +85,7 @@ nlohmann::json shared_json(const SharedLabels& r) {
       {"junction_curves", ps.junction_curves},
       {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
       {"plane_curves", ps.plane_curves},
+      {"continued_through_junctions", ps.continued},
       {"iterations", {{"junctions", ps.junctions.iterations}, {"interfaces", ps.interfaces.iterations}}},
       {"cubes_pinned", ps.cubes_pinned},
       {"cubes_reset", ps.cubes_reset},

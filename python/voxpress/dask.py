@@ -20,6 +20,8 @@ samples (exact mode: the caller smooths it, flats and sharp edges
 included). Dask does the scheduling, transfer
 and retries; nothing here is a scheduler.
 """
+import warnings
+
 import numpy as np
 
 from . import _voxpress
@@ -130,8 +132,9 @@ def press_labels(array, labels=None, *, chunk=256, spacing=(1.0, 1.0, 1.0), orig
     returning its part of the label table and its piece of the shared
     surface (global vertex keys: numpy arrays that pickle compactly). The
     caller assembles the whole shared surface (`press --labels --chunk`),
-    reads each label's box from the array for its flats (flats=False skips
-    that), presses it and cuts {label: Mesh} from it; interfaces=True also
+    reads each label's box from the array itself for its flats (Dask's
+    local threads: the caller must reach the array's storage; flats=False
+    skips that), presses it and cuts {label: Mesh} from it; interfaces=True also
     returns the shared surface with its label pairs. The caller holds the
     surface, never the volume. labels, spacing, origin, direction and the
     options are voxpress.press_labels's; client and threads as in press().
@@ -154,9 +157,10 @@ def press_labels(array, labels=None, *, chunk=256, spacing=(1.0, 1.0, 1.0), orig
         tasks.append(block(array[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, threads=threads))
     parts = client.gather(client.compute(tasks)) if client is not None else list(dask.compute(*tasks))
 
-    def read(lo, hi):  # a label's box, for its flats
-        box = array[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
-        return np.asarray(client.compute(box).result() if client is not None else box.compute())
+    def read(lo, hi):  # a label's box, for its flats: read by the caller (one small box per label, no round trip)
+        with warnings.catch_warnings():  # Dask warns of local threads while a Client is active: meant here
+            warnings.simplefilter("ignore", UserWarning)
+            return np.asarray(array[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]].compute(scheduler="threads"))
 
     if "disable_passes" in options and options["disable_passes"] is not None:
         options["disable_passes"] = list(options["disable_passes"])

@@ -258,6 +258,70 @@ std::vector<uint32_t> failing(const Mesh& m, const Cubes& c, const std::vector<u
   return out;
 }
 
+// Beyond the paper: where a surface continues smoothly through a junction
+// line (a sphere pressed into a box: its interfaces with the box and with
+// the background are one sphere), the two pieces of a plane's contour that
+// continue each other through a junction point are pressed as one curve
+// there, each with the other as context, instead of each ending at the
+// point. Pieces pair when they turn by less than this at the point,
+// measured on the midpoint surface over chords of kTangentCells cells:
+constexpr double kContinueDegrees = 35;  // organ-like junctions (~120 degrees each) never pair
+constexpr double kTangentCells = 3;      // the staircase's noise (half a cell) turns a chord by < 10 degrees
+
+// Per open chain end (2 k + e, e = 0 its first vertex, 1 its last): the
+// chain end continuing it through its junction point, or -1. Greedy by
+// increasing turning angle, each end paired once; deterministic.
+std::vector<int64_t> continuations(const SharedSurface& s, const Chains& c, const Graph& jg,
+                                   const std::vector<Vec3>& x0, const Mat3& M) {
+  const size_t n = c.closed.size();
+  std::vector<int64_t> partner(2 * n, -1);
+  const double cell = std::cbrt(s.lattice.spacing.prod());
+  std::vector<std::pair<uint32_t, uint32_t>> ends;  // (junction vertex, chain end)
+  for (size_t k = 0; k < n; ++k) {
+    if (c.closed[k] || c.offsets[k + 1] - c.offsets[k] < 3) continue;
+    for (uint32_t e = 0; e < 2; ++e) {
+      const uint32_t v = c.ids[e == 0 ? c.offsets[k] : c.offsets[k + 1] - 1];
+      if (jg.degree(v) > 0 && !is_stick(s.kind[v])) ends.push_back({v, uint32_t(2 * k + e)});
+    }
+  }
+  std::sort(ends.begin(), ends.end());
+  // Unit direction from the junction point into the chain, over a chord.
+  auto direction = [&](uint32_t end) {
+    const size_t k = end / 2;
+    const uint32_t b = c.offsets[k], e = c.offsets[k + 1], m = e - b;
+    const Vec3 p = M * x0[c.ids[end % 2 == 0 ? b : e - 1]];
+    Vec3 q = p;
+    for (uint32_t i = 1; i < m; ++i) {
+      q = M * x0[c.ids[end % 2 == 0 ? b + i : e - 1 - i]];
+      if ((q - p).norm() >= kTangentCells * cell) break;
+    }
+    return Vec3((q - p).normalized());
+  };
+  const double limit = std::cos(kContinueDegrees * std::numbers::pi / 180);
+  for (size_t i = 0; i < ends.size();) {
+    size_t j = i;
+    while (j < ends.size() && ends[j].first == ends[i].first) ++j;
+    if (j - i >= 3) {
+      std::vector<Vec3> dir;
+      for (size_t k = i; k < j; ++k) dir.push_back(direction(ends[k].second));
+      std::vector<std::tuple<double, size_t, size_t>> pairs;  // (-cos of the turn, a, b)
+      for (size_t a = 0; a < dir.size(); ++a)
+        for (size_t b = a + 1; b < dir.size(); ++b)
+          if (ends[i + a].second / 2 != ends[i + b].second / 2 && -dir[a].dot(dir[b]) >= limit)
+            pairs.push_back({dir[a].dot(dir[b]), a, b});
+      std::sort(pairs.begin(), pairs.end());
+      for (const auto& [cosine, a, b] : pairs) {
+        const uint32_t ea = ends[i + a].second, eb = ends[i + b].second;
+        if (partner[ea] >= 0 || partner[eb] >= 0) continue;
+        partner[ea] = eb;
+        partner[eb] = ea;
+      }
+    }
+    i = j;
+  }
+  return partner;
+}
+
 }  // namespace
 
 SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const SharedFlats* flats) {
@@ -330,17 +394,58 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
       mem.push_back(v);
     }
     const Chains pc = chains_of(g, barrier, mem);
+    const std::vector<int64_t> partner = continuations(s, pc, jg, x0, M);
+    detail::Family& f = families[size_t(a)];
     // CSR curves for the iteration: an open chain J1 .. J2 as a cycle whose
-    // closing segment J2 -> J1 joins two barriers (no vertex between them).
+    // closing segment J2 -> J1 joins two barriers (no vertex between them);
+    // a chain continued through a junction point by another (partner) as an
+    // open polyline with that piece as context beyond the point.
     for (size_t k = 0; k < pc.closed.size(); ++k) {
       uint32_t b = pc.offsets[k], e = pc.offsets[k + 1];
-      if (!pc.closed[k] && pc.ids[e - 1] == pc.ids[b]) --e;
-      ids[a].insert(ids[a].end(), pc.ids.begin() + b, pc.ids.begin() + e);
+      const int64_t before = pc.closed[k] ? -1 : partner[2 * k], after = pc.closed[k] ? -1 : partner[2 * k + 1];
+      if (before < 0 && after < 0) {
+        if (!pc.closed[k] && pc.ids[e - 1] == pc.ids[b]) --e;
+        ids[a].insert(ids[a].end(), pc.ids.begin() + b, pc.ids.begin() + e);
+        offsets[a].push_back(uint32_t(ids[a].size()));
+        f.spans.push_back({});
+        continue;
+      }
+      // The partner chain's vertices from its end at the junction point
+      // (excluded) away from it.
+      auto away = [&](int64_t end) {
+        const size_t q = size_t(end / 2);
+        const uint32_t qb = pc.offsets[q], qe = pc.offsets[q + 1];
+        std::vector<uint32_t> out(pc.ids.begin() + qb, pc.ids.begin() + qe);
+        if (end % 2 == 1) std::reverse(out.begin(), out.end());
+        out.erase(out.begin());
+        return out;
+      };
+      const size_t start = ids[a].size();
+      const bool loose = o.free_ends && e - b - 1 >= detail::kFreePiece;
+      if (before >= 0) {
+        std::vector<uint32_t> c = away(before);
+        ids[a].insert(ids[a].end(), c.rbegin(), c.rend());
+      }
+      // The junction point itself is left out where the curve goes on
+      // through it: its place (stage 1, inside its face square) would bend
+      // the continued curve towards it.
+      const uint32_t first = before >= 0 || loose ? b + 1 : b, last = after >= 0 || loose ? e - 1 : e;
+      detail::Family::Span sp;
+      sp.open = 1;
+      sp.free = loose;
+      sp.lo = uint32_t(ids[a].size() - start) + (first == b ? 1 : 0);
+      ids[a].insert(ids[a].end(), pc.ids.begin() + first, pc.ids.begin() + last);
+      sp.hi = uint32_t(ids[a].size() - start) - (last == e ? 1 : 0);
+      if (after >= 0) {
+        std::vector<uint32_t> c = away(after);
+        ids[a].insert(ids[a].end(), c.begin(), c.end());
+      }
       offsets[a].push_back(uint32_t(ids[a].size()));
+      f.spans.push_back(sp);
+      ++st.continued;
     }
     offsets[a].insert(offsets[a].begin(), 0u);
     st.plane_curves += pc.closed.size();
-    detail::Family& f = families[size_t(a)];
     f.ids = &ids[a];
     f.offsets = &offsets[a];
     f.g = {M.col(u).squaredNorm(), M.col(u).dot(M.col(w)), M.col(w).squaredNorm()};

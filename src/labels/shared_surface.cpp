@@ -37,6 +37,17 @@ struct Keys {
   }
 };
 
+// The distinct entries of one per-triangle array of every piece, increasing.
+template <class T, size_t N>
+std::vector<T> distinct(const std::vector<SharedPiece>& pieces, std::vector<std::array<T, N>> SharedPiece::*field) {
+  std::vector<T> out;
+  for (const SharedPiece& p : pieces)
+    for (const auto& e : p.*field) out.insert(out.end(), e.begin(), e.end());
+  tbb::parallel_sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 }  // namespace
 
 SharedPiece extract_shared_piece(const ScalarVolume& volume, const Box& read, const Box& core,
@@ -174,12 +185,7 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
   SharedSurface out;
   out.lattice = lattice;
   {
-    std::vector<uint32_t> values;
-    values.reserve(2 * m);
-    for (const SharedPiece& p : pieces)
-      for (const auto& v : p.values) values.insert(values.end(), v.begin(), v.end());
-    tbb::parallel_sort(values.begin(), values.end());
-    values.erase(std::unique(values.begin(), values.end()), values.end());
+    std::vector<uint32_t> values = distinct(pieces, &SharedPiece::values);
     if (values.empty()) throw InputError(source, "the volume is empty: every sample is the background, 0");
     if (values[0] != 0) values.insert(values.begin(), 0u);  // beyond the lattice is background
     out.labels = std::move(values);
@@ -189,12 +195,7 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
   };
 
   // Vertices: the keys in increasing order.
-  std::vector<uint64_t> all;
-  all.reserve(3 * m);
-  for (const SharedPiece& p : pieces)
-    for (const auto& k : p.keys) all.insert(all.end(), k.begin(), k.end());
-  tbb::parallel_sort(all.begin(), all.end());
-  all.erase(std::unique(all.begin(), all.end()), all.end());
+  const std::vector<uint64_t> all = distinct(pieces, &SharedPiece::keys);
   if (all.size() >= UINT32_MAX) throw LimitError(source, "more than 2^32 - 1 vertices");
   std::vector<std::pair<uint64_t, Vec3>> apex_positions;
   for (SharedPiece& p : pieces) {

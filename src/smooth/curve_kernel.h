@@ -16,6 +16,12 @@
 
 namespace voxpress::detail {
 
+// PressOptions::free_ends: pieces from barrier to barrier of at least this
+// many segments (7 vertices between the barriers) get free ends. Measured
+// 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
+// holes of plate_holes at 128^3 (docs/ARCHITECTURE.md at d97b886).
+inline constexpr uint32_t kFreePiece = 8;
+
 // A location on a polyline: point k + f (point k + 1 - point k); past a
 // free end (PressOptions::free_ends), that location reflected through the
 // end (mirror 1: the last point, 2: the first).
@@ -195,6 +201,16 @@ struct Family {
   std::vector<uint32_t> dst;  // per curve-vertex: its proposal's index, per_vertex * id + slot
   Metric g;
   double cell;  // cell side of the family's planes (d = arc_length * cell)
+  /// Per curve, optional (empty: every curve is a cycle cut at barriers):
+  /// an open polyline whose curve-vertices [lo, hi) propose and the others
+  /// are context only (the shared surface's pieces continued through a
+  /// junction point by the piece that continues them); free: its ends are
+  /// free ends (PressOptions::free_ends).
+  struct Span {
+    uint32_t lo = 0, hi = 0;
+    uint8_t open = 0, free = 0;
+  };
+  std::vector<Span> spans;
 };
 
 

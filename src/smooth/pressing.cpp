@@ -43,11 +43,6 @@ using detail::seconds_since;
 namespace {
 
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
-// PressOptions::free_ends: pieces from barrier to barrier of at least this
-// many segments (7 vertices between the barriers) get free ends. Measured
-// 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
-// holes of plate_holes at 128^3 (docs/ARCHITECTURE.md at d97b886).
-constexpr uint32_t kFreePiece = 8;
 
 // PressOptions::levels resolved (its comment has the rule). Only for 0 are
 // the n sticks' lower samples, lower(i) (D index coordinates), read: the
@@ -153,6 +148,15 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
               if (!frozen[ids[b + (from + i) % m]]) return true;
             return false;
           };
+          if (!fam.spans.empty() && fam.spans[c].open) {  // an open polyline with context ends
+            const Family::Span& sp = fam.spans[c];
+            if (!any_free(sp.lo, sp.hi - sp.lo)) continue;
+            w.resize(m);
+            for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
+            detail::curve_step(m, false, d, s2, o.resample, weighted, correction, g, w, sp.free != 0);
+            for (uint32_t i = sp.lo; i < sp.hi; ++i) emit(b + i, w.disp[i], w.tangent[i]);
+            continue;
+          }
           if (first_barrier == m) {
             if (!any_free(0, m)) continue;
             w.resize(m);
@@ -170,7 +174,7 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
               continue;
             }
             // Free ends: the piece without its two barriers (PressOptions::free_ends).
-            const bool loose = o.free_ends && len >= kFreePiece;
+            const bool loose = o.free_ends && len >= detail::kFreePiece;
             const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
             w.resize(count);
             for (uint32_t i = 0; i < count; ++i) gather(i, b + (first_barrier + k + lo + i) % m);

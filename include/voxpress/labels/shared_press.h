@@ -12,7 +12,10 @@
 //     labelled contours: curves of stick vertices between junction points
 //     (the face-centre vertices of the plane's faces). Every curve is
 //     pressed as in the binary case, the junction points as fixed barriers
-//     (PressOptions::free_ends applies to the pieces between them); each
+//     (PressOptions::free_ends applies to the pieces between them); two
+//     pieces that continue each other through a junction point (a sphere's
+//     interfaces with a box and with the background) are pressed there as
+//     one curve, each with the other as context, the point left out. Each
 //     stick vertex slides along its stick and averages its two planes'
 //     proposals.
 // Every vertex stays in its element (stick, face, cube), away from the
@@ -43,6 +46,7 @@ struct SharedPressStats {
   size_t junction_moving = 0;    ///< their vertices that move
   size_t junction_fixed = 0;     ///< junction vertices kept in place (branch and end points, 4+ labels)
   size_t plane_curves = 0;       ///< pieces of labelled contours and closed contours on the planes
+  size_t continued = 0;          ///< pieces pressed on through a junction point into the piece continuing them
   size_t cubes_pinned = 0;       ///< cubes that failed the exact check and were pressed again pinned
   size_t cubes_reset = 0;        ///< cubes put back at their midpoints after that
   size_t flat_vertices = 0;      ///< stick vertices frozen on a flat
