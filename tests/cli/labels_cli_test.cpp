@@ -168,6 +168,11 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
             2);
   EXPECT_FALSE(fs::exists(tmp.path("none")));
   EXPECT_FALSE(fs::exists(tmp.path("x.ply")));
+  // A memory cap below what pressing the shared surface needs: one line, nothing written.
+  EXPECT_EQ(run_cli("-q --max-memory 200K press " + tmp.path("map.nrrd") + " --labels all -o " + tmp.path("none"), &out), 1);
+  EXPECT_NE(out.find("memory limit"), std::string::npos) << out;
+  EXPECT_EQ(count_lines(out), 1u) << out;
+  EXPECT_FALSE(fs::exists(tmp.path("none")));
 }
 
 }  // namespace
