@@ -137,8 +137,7 @@ LabelSource open_labels(const std::string& input, const InputOptions& in, const 
     src.volume = load_volume(input, in, g);
     src.lattice = src.volume->lattice;
     src.table = label_table(*src.volume);
-    src.masks = masks_in(*src.volume);
-    return src;
+    return src;  // masks: set by the caller once src has its place (masks_in keeps a reference)
   }
   src.file = std::make_shared<const VolumeFile>(input, in.read_options(g));
   src.lattice = src.file->header().lattice;
@@ -165,6 +164,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   LabelSource src = open_labels(input, in, o, g, bar.get());
+  if (src.volume) src.masks = masks_in(*src.volume);
   LabelTable& table = src.table;
   if (!o.names_file.empty()) {
     const auto names = read_label_names(o.names_file);
