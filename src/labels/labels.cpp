@@ -291,9 +291,9 @@ std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> mask_box(const Lattice
   return {lo, hi};
 }
 
-// An empty mask of the label's box, its lattice's origin at the box's corner.
-BinaryVolume empty_mask(const Lattice& lattice, const std::string& source, const LabelInfo& label) {
-  const auto [lo, hi] = mask_box(lattice, label);
+// An empty mask of the box [lo, hi] (mask_box), its lattice's origin at the box's corner.
+BinaryVolume empty_mask(const Lattice& lattice, const std::string& source, const std::array<int64_t, 3>& lo,
+                        const std::array<int64_t, 3>& hi) {
   BinaryVolume b;
   b.source = source;
   b.lattice = lattice;
@@ -326,8 +326,8 @@ constexpr uint64_t kSlabSamples = uint64_t(1) << 24;  // a box is read this many
 }  // namespace
 
 BinaryVolume label_mask(const ScalarVolume& v, const LabelInfo& label) {
-  BinaryVolume b = empty_mask(v.lattice, v.source, label);
   const auto [lo, hi] = mask_box(v.lattice, label);
+  BinaryVolume b = empty_mask(v.lattice, v.source, lo, hi);
   mask_into(v, Box{lo, {hi[0] + 1, hi[1] + 1, hi[2] + 1}}, label, b.inside.data());
   return b;
 }
@@ -338,8 +338,8 @@ LabelMasks masks_in(const ScalarVolume& volume) {
 
 LabelMasks masks_read(const Lattice& lattice, const std::string& source, BoxRead read) {
   return [lattice, source, read = std::move(read)](const LabelInfo& label) {
-    BinaryVolume b = empty_mask(lattice, source, label);
     const auto [lo, hi] = mask_box(lattice, label);
+    BinaryVolume b = empty_mask(lattice, source, lo, hi);
     const auto& d = b.lattice.dims;
     const int64_t planes = std::max<int64_t>(1, int64_t(kSlabSamples / uint64_t(d[0] * d[1])));
     for (int64_t k0 = lo[2]; k0 <= hi[2]; k0 += planes) {

@@ -112,12 +112,6 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
         detail::Scratch<Vec2> w;
         for (size_t c = r.begin(); c < r.end(); ++c) {
           const uint32_t b = off[c], m = off[c + 1] - b;
-          // The curve, or its open pieces between barrier vertices, each
-          // piece starting and ending at a barrier (cyclically).
-          uint32_t first_barrier = m;
-          if (!barrier.empty())
-            for (uint32_t i = 0; i < m && first_barrier == m; ++i)
-              if (barrier[ids[b + i]]) first_barrier = i;
           auto emit = [&](uint32_t k, const Vec2& disp, const Vec2& tangent) {  // k: curve-vertex index
             const int mv = fam.mov[k];
             const uint32_t q = fam.dst[k];
@@ -157,6 +151,12 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
             for (uint32_t i = sp.lo; i < sp.hi; ++i) emit(b + i, w.disp[i], w.tangent[i]);
             continue;
           }
+          // The curve, or its open pieces between barrier vertices, each
+          // piece starting and ending at a barrier (cyclically).
+          uint32_t first_barrier = m;
+          if (!barrier.empty())
+            for (uint32_t i = 0; i < m && first_barrier == m; ++i)
+              if (barrier[ids[b + i]]) first_barrier = i;
           if (first_barrier == m) {
             if (!any_free(0, m)) continue;
             w.resize(m);
