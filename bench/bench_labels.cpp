@@ -3,12 +3,13 @@
 // sphere nested in that, a slab touching both: three- and four-label
 // junctions) on an anisotropic lattice, rotated at random per seed, scaled
 // by --scale. Per label: the RMS distance of its vertices to its true
-// boundary for the midpoint surface, the shared press and the binary press
-// of the label's mask alone (both with flats, without sharpening, as the
-// shared surface has none; --no-flats: both plain); for the junction
-// vertices (face centres and apexes), their distance to the true triple
-// lines. Prints Markdown tables (docs/BENCHMARKS.md).
-//   build/bench/bench_labels [--seeds N] [--scale S] [--iterations N] [--no-flats]
+// boundary for the midpoint surface, the shared press (press_shared_labels)
+// and the label's mask alone through smooth_surface, both with the same
+// options (by default flats and sharpening; --no-sharpen: flats only;
+// --no-flats: plain); for the junction vertices (face centres and apexes),
+// their distance to the true triple lines. Prints Markdown tables
+// (docs/BENCHMARKS.md).
+//   build/bench/bench_labels [--seeds N] [--scale S] [--iterations N] [--no-sharpen] [--no-flats]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -20,11 +21,15 @@
 #include <optional>
 #include <random>
 
+#include "voxpress/eval/metrics.h"
+#include "voxpress/eval/truth.h"
 #include "voxpress/voxpress.h"
 
 namespace {
 
 using namespace voxpress;
+
+bool ph_assembly(const std::string& phantom) { return phantom == "assembly"; }
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
@@ -40,13 +45,33 @@ struct Phantom {
   Mat3 R;        // frame -> volume rotation
   Vec3 centre;   // the frame's origin in the volume
   double scale;  // solid sizes in units of the tests' phantom
+  bool assembly = false;  // --phantom assembly: two boxes sharing part of a face
   Vec3 frame(const Vec3& p) const { return R.transpose() * (p - centre) / scale; }
+  // The assembly's boxes (centre, half sizes), frame units.
+  static constexpr double kBoxes[2][6] = {{-11, 0, 0, 11, 13, 11}, {9.5, 0, 0, 9.5, 11, 9.5}};
+  double assembly_box(const Vec3& p, int L) const {
+    const double* b = kBoxes[L - 1];
+    return box(frame(p), Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5])) * scale;
+  }
+  // The assembly's box L as a closed mesh (physical frame).
+  Mesh box_mesh(int L) const {
+    const double* b = kBoxes[L - 1];
+    Mesh m;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 q(b[0] + (k & 1 ? b[3] : -b[3]), b[1] + (k & 2 ? b[4] : -b[4]), b[2] + (k & 4 ? b[5] : -b[5]));
+      m.positions.push_back(centre + R * (q * scale));
+    }
+    m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    return m;
+  }
   std::array<double, 4> solids(const Vec3& p) const {
     const Vec3 q = frame(p);
     return {box(q, Vec3(-8, 0, 0), Vec3(7, 9, 8)), (q - Vec3(6, 0, 0)).norm() - 12, (q - Vec3(7, 0, 0)).norm() - 5,
             box(q, Vec3(0, 11, 0), Vec3(16, 2, 10))};
   }
   int label(const Vec3& p) const {
+    if (assembly) return assembly_box(p, 1) < 0 ? 1 : assembly_box(p, 2) < 0 ? 2 : 0;
     const auto [b, s12, s5, slab] = solids(p);
     if (s5 < 0) return 3;
     if (s12 < 0) return 2;
@@ -55,6 +80,7 @@ struct Phantom {
   }
   // Signed distance to label L's region (L = 0: the background), in scaled units.
   double region(const Vec3& p, int L) const {
+    if (assembly) return L == 0 ? -std::min(assembly_box(p, 1), assembly_box(p, 2)) : assembly_box(p, L);
     const auto [b, s12, s5, slab] = solids(p);
     double d = 0;
     switch (L) {
@@ -98,6 +124,8 @@ Vec3 onto_line(const Phantom& ph, const std::vector<int>& ls, Vec3 p) {
 struct Row {
   double mid = 0, shared = 0, binary = 0;
   size_t n = 0;
+  double t2r_shared = 0, t2r_binary = 0;  // assembly: squared truth -> result RMS per map
+  size_t maps = 0;
 };
 
 }  // namespace
@@ -111,10 +139,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.5, 8.0));
   PressOptions po;
   app.add_option("--iterations", po.iterations, "Pressing iterations (both stages, and the binary press)")->capture_default_str();
-  bool no_flats = false;
-  app.add_flag("--no-flats", no_flats, "Press both without flats");
+  std::string phantom = "organs";
+  app.add_option("--phantom", phantom, "organs: box, sphere pressed into it, nested sphere, slab; assembly: two boxes "
+                 "sharing part of a face")->check(CLI::IsMember({"organs", "assembly"}));
+  bool no_flats = false, no_sharpen = false;
+  app.add_flag("--no-flats", no_flats, "Press both without flats (and so without sharpening)");
+  app.add_flag("--no-sharpen", no_sharpen, "Press both with flats, without sharpening");
   CLI11_PARSE(app, argc, argv);
-  const FlatOptions fo;
+  SurfaceOptions so;
+  so.press = po;
+  if (no_flats) so.passes.disable(Pass::flats);
+  if (no_sharpen || no_flats) so.passes.disable(Pass::sharpen);
+  const char* what = no_flats ? "without flats" : no_sharpen ? "with flats, without sharpening" : "with flats and sharpening";
   const Vec3 spacing(1, 1.2, 1.5);
   const double cell = std::cbrt(spacing.prod());
   std::array<Row, 5> rows{};
@@ -122,12 +158,14 @@ int main(int argc, char** argv) {
   size_t unresolved = 0;
   std::map<std::pair<int, int>, std::array<double, 3>> interfaces;  // shared, midpoint sums, count                       // junction vertices whose projection did not converge
   double t_shared = 0, t_binary = 0;
+  size_t sharpened = 0;  // crease vertices the shared surface got
   for (int seed = 1; seed <= seeds; ++seed) {
     std::mt19937_64 rng{uint64_t(seed)};
     std::uniform_real_distribution<double> U(-1, 1);
     Phantom ph;
     ph.R = Eigen::AngleAxisd(std::acos(-1.0) * U(rng), Vec3(U(rng), U(rng), U(rng)).normalized()).toRotationMatrix();
     ph.scale = scale;
+    ph.assembly = phantom == "assembly";
     ScalarVolume v;
     // The phantom's reach (radius ~ 27 scaled units) fits in the box.
     const int64_t n = int64_t(std::ceil(58 * scale));
@@ -144,12 +182,13 @@ int main(int argc, char** argv) {
           v.bytes[size_t(v.lattice.linear(i, j, k))] =
               std::byte(ph.label(v.lattice.to_physical(Vec3(double(i), double(j), double(k)))));
     const SharedSurface mid = extract_shared_surface(v);
-    SharedSurface s = mid;
     double t0 = now();
-    std::optional<SharedFlats> sf;
-    if (!no_flats) sf = find_shared_flats(masks_in(v), s, label_table(v).labels, po, fo);
-    const SharedPressStats st = press_shared(s, po, sf ? &*sf : nullptr);
+    const SharedLabels sl = press_shared_labels(v, label_table(v), so);
     t_shared += now() - t0;
+    const SharedSurface& s = sl.surface;
+    const SharedPressStats& st = sl.press;
+    sharpened += sl.sharpen.inserted;
+    if (getenv("VP_DEBUG")) fprintf(stderr, "seed %d: shared sharpen labels %zu cubes %zu inserted %zu moved %zu back %zu undone %zu\n", seed, sl.sharpen.labels, sl.sharpen.cubes, sl.sharpen.inserted, sl.sharpen.moved, sl.sharpen.taken_back, sl.sharpen.labels_undone);
     for (uint32_t L = 1; L < s.labels.size(); ++L) {
       const int value = int(s.labels[L]);
       auto rms = [&](const Mesh& m) {
@@ -165,14 +204,24 @@ int main(int argc, char** argv) {
       sel.kind = Selection::Kind::label;
       sel.value = value;
       t0 = now();
-      StickSurface b = extract_sticks(binarize(v, sel));
-      press_with_flats(b, build_slice_curves(b), po, no_flats ? nullptr : &fo);
+      const SurfaceResult sr = smooth_surface(binarize(v, sel), so);
+      const Mesh& bm = sr.mesh;
+      if (getenv("VP_DEBUG")) fprintf(stderr, "  label %d alone: flats %zu inserted %zu; shared rms %.4f alone rms %.4f\n", value, sr.flats.flats.size(), sr.sharpen.inserted, std::sqrt(rms(pm) / pm.positions.size()), std::sqrt(rms(bm) / bm.positions.size()));
       t_binary += now() - t0;
-      const Mesh bm = to_mesh(b);
       r.binary += rms(bm) * double(pm.positions.size()) / double(bm.positions.size());
       r.n += pm.positions.size();
+      if (ph.assembly) {  // truth -> result: what a chamfer cuts off a crease
+        EvalOptions eo;
+        eo.samples = 100000;
+        eo.self_intersections = false;
+        const auto truth = mesh_truth(ph.box_mesh(value), "box");
+        r.t2r_shared += std::pow(evaluate(pm, *truth, eo).truth_to_result.rms / cell, 2);
+        r.t2r_binary += std::pow(evaluate(bm, *truth, eo).truth_to_result.rms / cell, 2);
+        ++r.maps;
+      }
     }
-    // Per interface: the RMS over its stick vertices (junction points left out).
+    // Per interface: the RMS over its stick vertices (junction points and
+    // crease vertices left out).
     for (size_t f = 0; f < s.sides.size(); ++f) {
       const int a = int(s.labels[s.sides[f][0]]), b = int(s.labels[s.sides[f][1]]);
       for (uint32_t w : s.mesh.triangles[f]) {
@@ -191,7 +240,7 @@ int main(int argc, char** argv) {
           if (std::find(around[w].begin(), around[w].end(), int(s.labels[L])) == around[w].end())
             around[w].push_back(int(s.labels[L]));
     for (size_t w = 0; w < s.mesh.positions.size(); ++w) {
-      if (s.kind[w] < 3 || around[w].size() < 3) continue;
+      if (s.kind[w] < 3 || s.kind[w] > 6 || around[w].size() < 3) continue;
       // The nearest point where three of its labels meet (the triple
       // lines of its labels, or their four-label point).
       auto distance = [&](const Vec3& p) {
@@ -214,17 +263,28 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "seed %d: %zu junction curves, %zu cubes pinned, %zu reset\n", seed, st.junction_curves,
                  st.cubes_pinned, st.cubes_reset);
   }
-  std::printf("Label phantom, scale %.2f, spacing 1 x 1.2 x 1.5, %d random rotations, %s: vertex RMS to each "
+  std::printf("Label phantom (%s), scale %.2f, spacing 1 x 1.2 x 1.5, %d random rotations, %s: vertex RMS to each "
               "label's true boundary (voxels)\n\n",
-              scale, seeds, no_flats ? "without flats" : "with flats (no sharpening)");
-  std::printf("| label | midpoint | shared press | binary press of the label alone | shared / binary |\n|---|---|---|---|---|\n");
-  const char* names[] = {"", "1 box", "2 sphere (pressed into the box)", "3 nested sphere", "4 slab"};
+              phantom.c_str(), scale, seeds, what);
+  std::printf("| label | midpoint | shared press | the label alone (smooth_surface) | shared / alone |\n|---|---|---|---|---|\n");
+  const char* organs[] = {"", "1 box", "2 sphere (pressed into the box)", "3 nested sphere", "4 slab"};
+  const char* boxes[] = {"", "1 larger box", "2 smaller box", "", ""};
+  const char* const* names = ph_assembly(phantom) ? boxes : organs;
   for (int L = 1; L <= 4; ++L) {
     const Row& r = rows[size_t(L)];
     if (r.n == 0) continue;
     const double m = std::sqrt(r.mid / double(r.n)), sh = std::sqrt(r.shared / double(r.n)),
                  bi = std::sqrt(r.binary / double(r.n));
     std::printf("| %s | %.4f | %.4f | %.4f | %.3f |\n", names[L], m, sh, bi, sh / bi);
+  }
+  if (ph_assembly(phantom)) {
+    std::printf("\nTruth -> result RMS (voxels; sampled on each true box: sees what a chamfer cuts off):\n\n"
+                "| label | shared press | the label alone | shared / alone |\n|---|---|---|---|\n");
+    for (int L = 1; L <= 2; ++L) {
+      const Row& r = rows[size_t(L)];
+      const double sh = std::sqrt(r.t2r_shared / double(r.maps)), bi = std::sqrt(r.t2r_binary / double(r.maps));
+      std::printf("| %s | %.4f | %.4f | %.3f |\n", names[L], sh, bi, sh / bi);
+    }
   }
   std::printf("\nPer interface (stick vertices of its triangles, counted once per triangle):\n\n| labels | midpoint | "
               "shared press |\n|---|---|---|\n");
@@ -244,7 +304,8 @@ int main(int argc, char** argv) {
     std::printf("| %s | %zu (+%zu unresolved) | %.3f | %.3f | %.3f | %.3f | %.1f %% |\n", list == &junction ? "shared press" : "midpoint",
                 d.size(), unresolved, mean / n, q(0.5), q(0.95), q(1.0), 100.0 * double(within) / n);
   }
-  std::printf("\nTime: shared press %.3f s per map, binary press of the labels one by one %.3f s per map\n",
-              t_shared / seeds, t_binary / seeds);
+  std::printf("\nCrease vertices inserted on the shared surface: %.1f per map\n", double(sharpened) / seeds);
+  std::printf("\nTime: shared press %.3f s per map, the labels one by one %.3f s per map\n", t_shared / seeds,
+              t_binary / seeds);
   return 0;
 }

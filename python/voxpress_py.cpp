@@ -282,9 +282,9 @@ void cut_labels(const SharedLabels& r, const std::vector<LabelInfo>& chosen, std
 }
 
 void check_shared_options(const py::kwargs& kw) {
-  for (const char* k : {"sharpen", "sharp_angle", "color_regions", "fit_rings"})
+  for (const char* k : {"color_regions", "fit_rings"})
     if (kw.contains(k))
-      throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface is not sharpened)");
+      throw UsageError(std::string(k) + "= applies to separate=True only (the shared surface has no region colours or quadric fit)");
 }
 
 std::vector<double> label_values(const py::object& labels) {

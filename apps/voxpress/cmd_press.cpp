@@ -220,11 +220,11 @@ void run_press(const PressCmd& c, const Global& g) {
   so.overrides.mu = c.overrides.mu;
   so.extract.max_bytes = g.memory_limit();
   if (labels) {
-    // The shared surface has flats but no sharpening (issue 54).
+    // The shared surface has no region colours and no quadric fit.
     if (pressing && !c.separate)
-      for (const char* name : {"--color-regions", "--no-sharpen", "--sharp-angle", "--fit-rings"})
+      for (const char* name : {"--color-regions", "--fit-rings"})
         if (c.cmd->count(name))
-          throw UsageError(std::string(name) + " applies to --separate only (the shared surface is not sharpened)");
+          throw UsageError(std::string(name) + " applies to --separate only (the shared surface has no region colours or quadric fit)");
     LabelOutput o;
     o.labels = c.labels;
     o.names_file = c.label_names;

@@ -81,7 +81,9 @@ nlohmann::json shared_json(const SharedLabels& r) {
   const SharedPressStats& ps = r.press;
   const std::optional<SharedFlats>& flats = r.flats;
   nlohmann::json stats = {
-      {"vertices", {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}}},
+      {"vertices",
+       {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices},
+        {"creases", r.sharpen.inserted}}},
       {"junction_curves", ps.junction_curves},
       {"junction_vertices", {{"moving", ps.junction_moving}, {"fixed", ps.junction_fixed}}},
       {"plane_curves", ps.plane_curves},
@@ -91,7 +93,20 @@ nlohmann::json shared_json(const SharedLabels& r) {
       {"cubes_reset", ps.cubes_reset},
       {"flats", nlohmann::json::array()},
       {"flat_vertices", ps.flat_vertices},
-      {"seconds", {{"extract", r.seconds_extract}, {"flats", flats ? flats->seconds : 0.0}, {"press", ps.seconds}}}};
+      {"sharpen",
+       {{"labels", r.sharpen.labels},
+        {"cubes", r.sharpen.cubes},
+        {"crease_vertices", r.sharpen.inserted},
+        {"corners", r.sharpen.corners},
+        {"moved", r.sharpen.moved},
+        {"sharp_edges", r.sharpen.sharp_edges},
+        {"taken_back", r.sharpen.taken_back},
+        {"labels_undone", r.sharpen.labels_undone}}},
+      {"seconds",
+       {{"extract", r.seconds_extract},
+        {"flats", flats ? flats->seconds : 0.0},
+        {"press", ps.seconds},
+        {"sharpen", r.sharpen.seconds}}}};
   if (flats)  // each flat: the label it was found on, its plane and area
     for (size_t i = 0; i < flats->flats.size(); ++i) {
       const Flat& f = flats->flats[i];

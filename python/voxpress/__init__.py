@@ -75,8 +75,9 @@ def press_labels(array, labels=None, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
     InputError). By default every label is cut from one pressed shared
     surface: touching labels share their interface vertex for vertex, each
     mesh keeps its own label's samples inside and every other sample
-    outside; each label's flats are found (flats=False: none), there is no
-    sharpening. interfaces=True returns ({label: Mesh}, the shared surface
+    outside; each label's flats are found (flats=False: none) and their
+    creases sharpened once for both sides (sharpen=False: chamfers).
+    interfaces=True returns ({label: Mesh}, the shared surface
     with face attributes label_in / label_out). separate=True (or a baseline
     method) meshes each label alone on its box, with the whole feature
     layer. spacing, origin, direction, axes, method and the options are

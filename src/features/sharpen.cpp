@@ -32,6 +32,8 @@ SharpenResult Sharpener::run() {
     timed(Pass::sharpen, [&] { subdivide(); });
   } else {
     tris = s.triangles;
+    parent.resize(tris.size());
+    std::iota(parent.begin(), parent.end(), 0u);
   }
   if (!nv.empty()) {
     index();

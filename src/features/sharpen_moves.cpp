@@ -31,6 +31,7 @@ void Sharpener::subdivide() {
       }
       if (den > 1e-12) u = std::clamp(num / den, 0.1, 0.9);
       start = xa + u * (xb - xa);
+      v.u = u;
       const double angle = angle_deg(pa->n, pb->n);
       v.angle = angle;
       v.sharp = angle >= o.sharp_angle;
@@ -48,16 +49,28 @@ void Sharpener::subdivide() {
     }
     return it->second = add_vertex(v, start);
   };
+  // Restricted (editable): the edges of the triangles that are not editable
+  // get no vertex, so no triangle outside the part is split.
+  std::vector<uint64_t> blocked;
+  if (editable)
+    for (size_t f = 0; f < s.triangles.size(); ++f)
+      if (!(*editable)[f])
+        for (int e = 0; e < 3; ++e) blocked.push_back(edge_key(s.triangles[f][size_t(e)], s.triangles[f][size_t((e + 1) % 3)]));
+  std::sort(blocked.begin(), blocked.end());
   for (size_t f = 0; f < s.triangles.size(); ++f) {
     const Triangle& t = s.triangles[f];
     uint32_t m[3];
     int k = 0;
     for (int e = 0; e < 3; ++e) {
       const uint32_t a = t[size_t(e)], b = t[size_t((e + 1) % 3)];
-      m[e] = chamfer(a, b) ? edge_vertex(a, b) : kNone;
+      const bool open = blocked.empty() || !std::binary_search(blocked.begin(), blocked.end(), edge_key(a, b));
+      m[e] = open && chamfer(a, b) ? edge_vertex(a, b) : kNone;
       k += m[e] != kNone;
     }
-    auto emit = [&](uint32_t a, uint32_t b, uint32_t c) { tris.push_back({a, b, c}); };
+    auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+      tris.push_back({a, b, c});
+      parent.push_back(uint32_t(f));
+    };
     if (k == 0) {
       emit(t[0], t[1], t[2]);
       continue;
@@ -85,6 +98,7 @@ void Sharpener::subdivide() {
     } else {  // Fig. 8c: six triangles around a corner vertex
       NewVertex c;
       c.corner = true;
+      c.from = {m[0], m[1], m[2]};
       const Vec3 start = (x[m[0]] + x[m[1]] + x[m[2]]) / 3;
       const Plane* p[3] = {plane_of(t[0]), plane_of(t[1]), plane_of(t[2])};
       c.on_flats = label[t[0]] >= 0 && label[t[1]] >= 0 && label[t[2]] >= 0;
@@ -239,6 +253,7 @@ bool Sharpener::allowed(uint32_t v, const Vec3& q) const {
 bool Sharpener::move(uint32_t v, const Vec3& q, bool partial) {
   const Vec3 p = x[v];
   if (q == p) return true;
+  if (v < n && fixed && (*fixed)[v]) return false;
   if (allowed(v, q)) {
     x[v] = q;
     widen(v);

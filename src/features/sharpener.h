@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <unordered_map>
 
 #include <tbb/blocked_range.h>
@@ -94,6 +95,8 @@ struct NewVertex {
   bool sharp = false;             // on a labelled sharp crease
   bool on_flats = false;          // its target lies on flats' planes only (not a curved side's fit)
   double angle = 0;               // edge vertex: degrees between its two planes' normals
+  double u = 0.5;                 // edge vertex: inserted at x[a] + u (x[b] - x[a])
+  std::array<uint32_t, 3> from{kNone, kNone, kNone};  // corner: its three edge vertices
 };
 
 struct Sharpener {
@@ -124,6 +127,10 @@ struct Sharpener {
   // pairs) so that float32 output keeps the guarantee (core/clearance.h).
   double delta = 0;
   SharpenStats st;
+  // Part of a larger surface (labels/shared_sharpen.cpp; null: all): chamfer edges
+  // only between two `editable` triangles; `fixed` original vertices never move.
+  const std::vector<uint8_t>*editable = nullptr, *fixed = nullptr;
+  std::vector<uint32_t> parent;  // per refined triangle: the original triangle it came from
 
   Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
       : s(surface), seg(f), o(opts), n(surface.stick_count()) {
@@ -160,6 +167,7 @@ struct Sharpener {
   // Puts v on its stick at t, kept in [margin, 1 - margin] (no sample
   // changes side: Pressing's guarantee).
   void slide(uint32_t v, double t) {
+    if (fixed && (*fixed)[v]) return;
     const Vec3 in = s.inside_sample(v);
     x[v] = in + std::clamp(t, o.margin, 1 - o.margin) * (s.outside_sample(v) - in);
   }

@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "core/timing.h"
+#include "shared_sticks.h"
 #include "voxpress/labels/labels.h"
 
 namespace voxpress {
@@ -42,18 +43,10 @@ SharedFlats find_shared_flats(const LabelMasks& masks, const SharedSurface& s, c
   out.t.assign(n, std::numeric_limits<double>::quiet_NaN());
   out.barrier.assign(n, 0);
   out.region.assign(n, -1);
-  // The shared stick vertices by global stick key (lower sample padded),
-  // for the labels' lookups.
-  const auto& dims = s.lattice.dims;
-  auto key = [&](const std::array<int64_t, 3>& lower, int axis) {
-    return stick_key(dims, {lower[0] + 1, lower[1] + 1, lower[2] + 1}, axis);
-  };
-  std::vector<std::pair<uint64_t, uint32_t>> sticks;
-  for (uint32_t v = 0; v < n; ++v)
-    if (s.kind[v] < 3) sticks.push_back({key(s.corner[v], s.kind[v]), v});
-  std::sort(sticks.begin(), sticks.end());
+  const detail::SharedSticks sticks(s);
 
   std::vector<LabelFlats> per(labels.size());
+  out.segmentations.resize(labels.size());
   FlatOptions fo = options;
   fo.progress = nullptr;
   PressOptions po = press;
@@ -63,23 +56,22 @@ SharedFlats find_shared_flats(const LabelMasks& masks, const SharedSurface& s, c
   tbb::parallel_for(size_t(0), labels.size(), [&](size_t i) {
     const LabelInfo& label = labels[i];
     const BinaryVolume mask = masks(label);
-    const std::array<int64_t, 3> lo = {std::max<int64_t>(0, label.lo[0] - 1), std::max<int64_t>(0, label.lo[1] - 1),
-                                       std::max<int64_t>(0, label.lo[2] - 1)};
+    const std::array<int64_t, 3> lo = detail::mask_origin(label.lo);
     StickSurface surface = extract_sticks(mask);
     const SliceCurves curves = build_slice_curves(surface);
     FlatSegmentation seg;
     press_with_flats(surface, curves, po, &fo, &seg);
     LabelFlats& lf = per[i];
     lf.flats = seg.flats;
+    const bool has_flats = !seg.flats.empty();
+    if (has_flats) out.segmentations[i] = std::move(seg);
+    const FlatSegmentation& kept = has_flats ? out.segmentations[i] : seg;
     for (size_t k = 0; k < surface.stick_count(); ++k) {
-      if (seg.region[k] < 0) continue;
-      std::array<int64_t, 3> lower = surface.lower_index(k);
-      for (int a = 0; a < 3; ++a) lower[size_t(a)] += lo[size_t(a)];
-      const uint64_t want = key(lower, surface.axis(k));
-      const auto it = std::lower_bound(sticks.begin(), sticks.end(), std::pair<uint64_t, uint32_t>{want, 0});
-      if (it == sticks.end() || it->first != want) continue;  // cannot happen: a label's sticks are shared sticks
+      if (kept.region[k] < 0) continue;
+      const uint32_t v = sticks.find(surface, k, lo);
+      if (v == UINT32_MAX) continue;  // cannot happen: a label's sticks are shared sticks
       // surface.t: from the lower sample, as the shared surface (seg.t is from the inside one).
-      lf.entries.push_back({it->second, surface.t[k], seg.barrier[k], seg.region[k]});
+      lf.entries.push_back({v, surface.t[k], kept.barrier[k], kept.region[k]});
     }
     if (progress) progress->update(++done);
   });

@@ -584,6 +584,11 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
     r.flats = find_shared_flats(masks, r.surface, table.labels, po, fo, o.progress);
   }
   r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr);
+  if (r.flats && o.passes.on(Pass::sharpen)) {
+    SharpenOptions so = o.sharp;
+    so.passes = o.passes;
+    r.sharpen = sharpen_shared(r.surface, *r.flats, masks, table.labels, so);
+  }
   return r;
 }
 

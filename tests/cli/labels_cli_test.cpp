@@ -108,9 +108,9 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
       << out;
   EXPECT_FALSE(nlohmann::json::parse(test::read_file(tmp.path("alone/labels.json")))["shared"].get<bool>());
   EXPECT_FALSE(fs::exists(tmp.path("alone/interfaces.ply")));
-  // Sharpening's options need --separate (the shared surface has flats, no
-  // sharpening); --separate needs --labels.
-  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --no-sharpen -o " + tmp.path("none"), &out), 2);
+  // Region colours need --separate (the shared surface has none); --separate
+  // needs --labels.
+  EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --color-regions -o " + tmp.path("none"), &out), 2);
   EXPECT_NE(out.find("--separate"), std::string::npos) << out;
   EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --separate -o " + tmp.path("x.ply"), &out), 2);
   ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels 300,7 --format stl -o " + tmp.path("two"), &out), 0)

@@ -250,7 +250,7 @@ def test_press_labels_every_label_at_once(tmp_path):
     alone = voxpress.press_labels(labels, spacing=(1, 1, 1.5), separate=True)
     assert not alone[9].stats["shared"] and alone[9].stats["flats"] >= 0
     with pytest.raises(voxpress.UsageError, match="separate"):
-        voxpress.press_labels(labels, sharpen=False)
+        voxpress.press_labels(labels, color_regions=True)
     # Flats of the shared surface can be turned off: the plain shared press.
     plain, plain_shared = voxpress.press_labels(labels, spacing=(1, 1, 1.5), flats=False, interfaces=True)
     assert plain_shared.stats["flats"] == 0 and plain_shared.stats["flat_vertices"] == 0

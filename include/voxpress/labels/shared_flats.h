@@ -11,7 +11,7 @@
 // cuts the slice curves there. An interface between two labels is seen by
 // both; where both freeze a vertex the label of lower value decides its t
 // (the two planes are the same face seen from either side, within their fit).
-// Sharpening (crease insertion) is not done on the shared surface.
+// Sharpening: shared_sharpen.h.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +31,10 @@ struct SharedFlats {
   std::vector<int32_t> region;     ///< per shared vertex: index in `flats`, or -1
   std::vector<Flat> flats;         ///< every label's flats, by label then the label's own order
   std::vector<uint32_t> flat_label;  ///< per flat: the value of the label it was found on
+  /// Per label (in the order given): its own binary segmentation, on the
+  /// sticks of its mask's surface (extract_sticks of masks(label)); empty
+  /// for a label without flats. The sharpening starts from it (shared_sharpen.h).
+  std::vector<FlatSegmentation> segmentations;
   size_t frozen = 0;               ///< vertices frozen
   double seconds = 0;
   /// Flats found on the label of this value.

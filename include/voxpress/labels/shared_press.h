@@ -36,6 +36,7 @@
 #include <optional>
 
 #include "voxpress/labels/shared_flats.h"
+#include "voxpress/labels/shared_sharpen.h"
 #include "voxpress/labels/shared_surface.h"
 #include "voxpress/smooth/pressing.h"
 
@@ -65,12 +66,14 @@ SharedPressStats press_shared(SharedSurface& surface, const PressOptions& option
 /// What `press --labels` and Python's press_labels() do by default: the
 /// shared surface of `volume` (whose labels and boxes `table` lists),
 /// each label's flats when options.passes has them, pressed by
-/// options.press (with options.overrides). Throws InputError when float32
+/// options.press (with options.overrides), then sharpened where labels have
+/// flats (options.sharp, Pass::sharpen; shared_sharpen.h). Throws InputError when float32
 /// output could not keep every sample on its side (require_float32_room).
 struct SharedLabels {
   SharedSurface surface;
   std::optional<SharedFlats> flats;  ///< empty with --no-flats
   SharedPressStats press;
+  SharedSharpenStats sharpen;  ///< labels with flats, when options.passes has Pass::sharpen
   double seconds_extract = 0;
 };
 SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& options);

@@ -31,7 +31,8 @@ struct SharedSurface {
   Mesh mesh;                     ///< physical positions; every interface triangle once
   std::vector<std::array<uint32_t, 2>> sides;  ///< per triangle: (in, out) label indices
   /// Per vertex, what it lies on: kind 0-2 a stick along that axis, 3-5 a
-  /// face normal to axis kind - 3, 6 an apex inside a cube; `corner` the
+  /// face normal to axis kind - 3, 6 an apex inside a cube, 7 a crease
+  /// vertex the sharpening inserted (shared_sharpen.h); `corner` the
   /// (unpadded, may be -1) index of the stick's lower sample or of the
   /// face's or the cube's lowest corner.
   std::vector<uint8_t> kind;
