@@ -123,7 +123,7 @@ Vec3 onto_line(const Phantom& ph, const std::vector<int>& ls, Vec3 p) {
 
 struct Row {
   double mid = 0, shared = 0, binary = 0;
-  size_t n = 0;
+  size_t n = 0, n_mid = 0;
   double t2r_shared = 0, t2r_binary = 0;  // assembly: squared truth -> result RMS per map
   size_t maps = 0;
 };
@@ -188,7 +188,6 @@ int main(int argc, char** argv) {
     const SharedSurface& s = sl.surface;
     const SharedPressStats& st = sl.press;
     sharpened += sl.sharpen.inserted;
-    if (getenv("VP_DEBUG")) fprintf(stderr, "seed %d: shared sharpen labels %zu cubes %zu inserted %zu moved %zu back %zu undone %zu\n", seed, sl.sharpen.labels, sl.sharpen.cubes, sl.sharpen.inserted, sl.sharpen.moved, sl.sharpen.taken_back, sl.sharpen.labels_undone);
     for (uint32_t L = 1; L < s.labels.size(); ++L) {
       const int value = int(s.labels[L]);
       auto rms = [&](const Mesh& m) {
@@ -198,7 +197,9 @@ int main(int argc, char** argv) {
       };
       Row& r = rows[size_t(value)];
       const Mesh pm = label_mesh(s, L);
-      r.mid += rms(label_mesh(mid, L));
+      const Mesh mm = label_mesh(mid, L);
+      r.mid += rms(mm);
+      r.n_mid += mm.positions.size();
       r.shared += rms(pm);
       Selection sel;
       sel.kind = Selection::Kind::label;
@@ -206,7 +207,6 @@ int main(int argc, char** argv) {
       t0 = now();
       const SurfaceResult sr = smooth_surface(binarize(v, sel), so);
       const Mesh& bm = sr.mesh;
-      if (getenv("VP_DEBUG")) fprintf(stderr, "  label %d alone: flats %zu inserted %zu; shared rms %.4f alone rms %.4f\n", value, sr.flats.flats.size(), sr.sharpen.inserted, std::sqrt(rms(pm) / pm.positions.size()), std::sqrt(rms(bm) / bm.positions.size()));
       t_binary += now() - t0;
       r.binary += rms(bm) * double(pm.positions.size()) / double(bm.positions.size());
       r.n += pm.positions.size();
@@ -273,7 +273,7 @@ int main(int argc, char** argv) {
   for (int L = 1; L <= 4; ++L) {
     const Row& r = rows[size_t(L)];
     if (r.n == 0) continue;
-    const double m = std::sqrt(r.mid / double(r.n)), sh = std::sqrt(r.shared / double(r.n)),
+    const double m = std::sqrt(r.mid / double(r.n_mid)), sh = std::sqrt(r.shared / double(r.n)),
                  bi = std::sqrt(r.binary / double(r.n));
     std::printf("| %s | %.4f | %.4f | %.4f | %.3f |\n", names[L], m, sh, bi, sh / bi);
   }
