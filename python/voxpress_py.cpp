@@ -267,7 +267,9 @@ py::object labels_result(const std::vector<LabelInfo>& chosen, std::vector<Mesh>
   all.stats["cubes_reset"] = ps.cubes_reset;
   all.stats["flats"] = shared->flats ? shared->flats->flats.size() : 0;
   all.stats["flat_vertices"] = ps.flat_vertices;
-  all.stats["seconds"] = ps.seconds;
+  all.stats["fitted_vertices"] = shared->fit.moved;
+  all.stats["crease_vertices"] = shared->sharpen.inserted;
+  all.stats["seconds"] = ps.seconds + shared->fit.seconds + shared->sharpen.seconds;
   return py::make_tuple(out, all);
 }
 

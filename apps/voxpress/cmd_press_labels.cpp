@@ -93,6 +93,12 @@ nlohmann::json shared_json(const SharedLabels& r) {
       {"cubes_reset", ps.cubes_reset},
       {"flats", nlohmann::json::array()},
       {"flat_vertices", ps.flat_vertices},
+      {"quadric_fit",
+       {{"labels", r.fit.labels},
+        {"cubes", r.fit.cubes},
+        {"fitted", r.fit.fitted},
+        {"moved", r.fit.moved},
+        {"cubes_put_back", r.fit.cubes_put_back}}},
       {"sharpen",
        {{"labels", r.sharpen.labels},
         {"cubes", r.sharpen.cubes},
@@ -106,6 +112,7 @@ nlohmann::json shared_json(const SharedLabels& r) {
        {{"extract", r.seconds_extract},
         {"flats", flats ? flats->seconds : 0.0},
         {"press", ps.seconds},
+        {"quadric_fit", r.fit.seconds},
         {"sharpen", r.sharpen.seconds}}}};
   if (flats)  // each flat: the label it was found on, its plane and area
     for (size_t i = 0; i < flats->flats.size(); ++i) {

@@ -18,11 +18,13 @@
 #include "core/predicates.h"
 #include "core/sentinel.h"
 #include "core/timing.h"
+#include "cube_check.h"
 #include "smooth/curve_kernel.h"
 
 namespace voxpress {
 namespace {
 
+using detail::Cubes;
 using detail::kNone;
 
 bool is_stick(uint8_t kind) { return kind < 3; }
@@ -186,76 +188,6 @@ PressStats press_junctions(const SharedSurface& s, const Chains& c, const std::v
   }
   st.seconds = detail::seconds_since(t0);
   return st;
-}
-
-// The triangles of each cube (every triangle lies in one cube: its
-// midpoint centroid is strictly inside it, as no triangle has its three
-// vertices on one face), as groups of a CSR list, and for each vertex the
-// groups it has triangles in.
-struct Cubes {
-  std::vector<uint32_t> tris, offsets{0};
-  std::vector<uint32_t> vertex_offsets, vertex_groups;
-};
-
-Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0) {
-  Cubes c;
-  const size_t nt = m.triangles.size();
-  std::vector<std::pair<std::array<int64_t, 3>, uint32_t>> key(nt);
-  tbb::parallel_for(size_t(0), nt, [&](size_t f) {
-    const Triangle& t = m.triangles[f];
-    const Vec3 g = (x0[t[0]] + x0[t[1]] + x0[t[2]]) / 3;
-    key[f] = {{int64_t(std::floor(g[0])), int64_t(std::floor(g[1])), int64_t(std::floor(g[2]))}, uint32_t(f)};
-  });
-  tbb::parallel_sort(key.begin(), key.end());
-  for (size_t i = 0; i < nt; ++i) {
-    if (i > 0 && key[i].first != key[i - 1].first) c.offsets.push_back(uint32_t(i));
-    c.tris.push_back(key[i].second);
-  }
-  if (nt > 0) c.offsets.push_back(uint32_t(nt));
-  std::vector<std::pair<uint32_t, uint32_t>> vg;  // (vertex, group)
-  for (uint32_t g = 0; g + 1 < c.offsets.size(); ++g)
-    for (uint32_t k = c.offsets[g]; k < c.offsets[g + 1]; ++k)
-      for (uint32_t v : m.triangles[c.tris[k]]) vg.push_back({v, g});
-  tbb::parallel_sort(vg.begin(), vg.end());
-  vg.erase(std::unique(vg.begin(), vg.end()), vg.end());
-  c.vertex_offsets.assign(x0.size() + 1, 0);
-  for (const auto& [v, g] : vg) ++c.vertex_offsets[v + 1], c.vertex_groups.push_back(g);
-  for (size_t v = 0; v < x0.size(); ++v) c.vertex_offsets[v + 1] += c.vertex_offsets[v];
-  return c;
-}
-
-// Is the surface inside cube group g valid once stored in float32: no
-// triangle with an altitude under delta (cells), no two triangles meeting
-// or within delta of each other beyond what they share (exact predicates;
-// core/clearance.h)? Triangles of different cubes meet only in the segments
-// a shared face's contour is made of, which both cubes use: so a surface
-// whose every cube passes is free of self-intersection.
-bool cube_ok(const Mesh& m, const Cubes& c, uint32_t g, const std::vector<Vec3>& x, double delta) {
-  for (uint32_t i = c.offsets[g]; i < c.offsets[g + 1]; ++i) {
-    const Triangle& a = m.triangles[c.tris[i]];
-    const Vec3 pa[3] = {x[a[0]], x[a[1]], x[a[2]]};
-    if (detail::triangle_degenerate(pa[0], pa[1], pa[2]) || detail::triangle_altitude(pa[0], pa[1], pa[2]) < delta)
-      return false;
-    const uint32_t ia[3] = {a[0], a[1], a[2]};
-    for (uint32_t j = c.offsets[g]; j < i; ++j) {
-      const Triangle& b = m.triangles[c.tris[j]];
-      const Vec3 pb[3] = {x[b[0]], x[b[1]], x[b[2]]};
-      const uint32_t ib[3] = {b[0], b[1], b[2]};
-      if (detail::triangles_intersect(pa, ia, pb, ib) || detail::triangles_within(pa, ia, pb, ib, delta)) return false;
-    }
-  }
-  return true;
-}
-
-// The failing groups among `groups` (increasing).
-std::vector<uint32_t> failing(const Mesh& m, const Cubes& c, const std::vector<uint32_t>& groups,
-                              const std::vector<Vec3>& x, double delta) {
-  std::vector<uint8_t> bad(groups.size(), 0);
-  tbb::parallel_for(size_t(0), groups.size(), [&](size_t k) { bad[k] = !cube_ok(m, c, groups[k], x, delta); });
-  std::vector<uint32_t> out;
-  for (size_t k = 0; k < groups.size(); ++k)
-    if (bad[k]) out.push_back(groups[k]);
-  return out;
 }
 
 // Beyond the paper: where a surface continues smoothly through a junction
@@ -463,7 +395,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
     }
   }
 
-  const Cubes cubes = cubes_of(s.mesh, x0);
+  const Cubes cubes = detail::cubes_of(s.mesh, x0);
   const double delta = detail::float32_clearance(s.lattice);
   std::vector<uint32_t> all(cubes.offsets.size() - 1);
   for (uint32_t g = 0; g < all.size(); ++g) all[g] = g;
@@ -515,35 +447,15 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
         for (uint32_t v : s.mesh.triangles[cubes.tris[k]]) pinned[v] = 1;
   };
   run();
-  std::vector<uint32_t> bad = failing(s.mesh, cubes, all, x, delta);
+  std::vector<uint32_t> bad = detail::failing_cubes(s.mesh, cubes, all, x, delta);
   if (!bad.empty()) {
     st.cubes_pinned = bad.size();
     pin(bad);
     run();
-    bad = failing(s.mesh, cubes, all, x, delta);
+    bad = detail::failing_cubes(s.mesh, cubes, all, x, delta);
   }
   std::vector<uint8_t> reset(n, 0);
-  while (!bad.empty()) {
-    std::vector<uint32_t> touched;
-    for (uint32_t g : bad) {
-      bool fresh = false;  // a cube already all at its midpoints cannot do better: left as it is
-      for (uint32_t k = cubes.offsets[g]; k < cubes.offsets[g + 1]; ++k)
-        for (uint32_t v : s.mesh.triangles[cubes.tris[k]]) fresh = fresh || !reset[v];
-      st.cubes_reset += fresh;
-      if (!fresh) continue;
-      for (uint32_t k = cubes.offsets[g]; k < cubes.offsets[g + 1]; ++k)
-        for (uint32_t v : s.mesh.triangles[cubes.tris[k]]) {
-          if (reset[v]) continue;
-          reset[v] = 1;
-          x[v] = x0[v];
-          touched.insert(touched.end(), cubes.vertex_groups.begin() + cubes.vertex_offsets[v],
-                         cubes.vertex_groups.begin() + cubes.vertex_offsets[v + 1]);
-        }
-    }
-    std::sort(touched.begin(), touched.end());
-    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    bad = failing(s.mesh, cubes, touched, x, delta);
-  }
+  st.cubes_reset = detail::put_back(s.mesh, cubes, std::move(bad), x, x0, reset, delta);
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
     if (x[v] != x0[v]) s.mesh.positions[v] = s.lattice.to_physical(x[v]);  // the others keep their bits
   });
@@ -584,6 +496,11 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
     r.flats = find_shared_flats(masks, r.surface, table.labels, po, fo, o.progress);
   }
   r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr);
+  if (o.passes.on(Pass::quadric_fit)) {
+    QuadricFitOptions fit = o.fit;
+    fit.margin = po.margin;
+    r.fit = fit_shared_quadrics(r.surface, masks, table.labels, r.flats ? &*r.flats : nullptr, fit);
+  }
   if (r.flats && o.passes.on(Pass::sharpen)) {
     SharpenOptions so = o.sharp;
     so.passes = o.passes;

@@ -14,46 +14,15 @@
 #include "core/predicates.h"
 #include "core/timing.h"
 #include "features/sharpener.h"
-#include "shared_sticks.h"
+#include "label_view.h"
 
 namespace voxpress {
 namespace {
 
-using Cube = std::array<int64_t, 3>;
+using detail::Cube;
+using detail::floor_of;
+using detail::LabelView;
 constexpr uint8_t kCreaseKind = 7;  // SharedSurface::kind of a vertex the sharpening inserted
-
-Cube floor_of(const Vec3& p) {
-  return {int64_t(std::floor(p[0])), int64_t(std::floor(p[1])), int64_t(std::floor(p[2]))};
-}
-
-// Index-space centre of a shared vertex's element (stick, face or cube).
-Vec3 element_centre(const SharedSurface& s, uint32_t v) {
-  Vec3 p(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
-  const int k = s.kind[v];
-  if (k < 3) {
-    p[k] += 0.5;
-  } else if (k < 6) {
-    p[(k - 3 + 1) % 3] += 0.5;
-    p[(k - 3 + 2) % 3] += 0.5;
-  } else {
-    p.array() += 0.5;
-  }
-  return p;
-}
-
-// The same triangle turned so that its smallest vertex comes first.
-Triangle canonical(const Triangle& t) {
-  const int i = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
-  return {t[size_t(i)], t[size_t((i + 1) % 3)], t[size_t((i + 2) % 3)]};
-}
-
-// The shared triangles grouped by the cube they lie in (every triangle of
-// press_shared lies in one: its elements' centres' centroid is inside it).
-struct CubeGroups {
-  std::vector<std::pair<Cube, uint32_t>> tris;  // sorted by cube
-  std::vector<size_t> offsets{0};               // group g: tris[offsets[g], offsets[g + 1])
-  std::vector<uint32_t> owner;                  // per group: the label index sharpening it, or UINT32_MAX
-};
 
 // What one label's sharpening changes. Every change can be taken back
 // alone (apply's `back`): a moved stick vertex to where it was, a new
@@ -65,8 +34,8 @@ struct LabelEdit {
   std::vector<uint32_t> idx;                      // the label's stick k -> shared vertex
   std::vector<std::pair<uint32_t, Vec3>> moved;   // shared vertex, new index-space position
   struct Fresh {
-    Vec3 at;                                      // index space
-    Cube cube;                                    // the cube of the triangle it was inserted in
+    Vec3 at = Vec3::Zero();                       // index space
+    Cube cube{};                                  // the cube of the triangle it was inserted in
     uint32_t a = 0, b = 0;                        // edge vertex: the edge's ends (the label's sticks)
     double u = 0.5;                               // ... inserted at a + u (b - a)
     std::array<uint32_t, 3> from{};               // corner: its edge vertices (indices into fresh)
@@ -83,98 +52,33 @@ struct LabelEdit {
   double delta = 0;                               // the clearance its sharpening kept (cells)
 };
 
-// Sharpens label L (index into s.labels) on the groups it owns (`mine`).
-LabelEdit sharpen_label(const SharedSurface& s, const CubeGroups& cubes, const std::vector<uint32_t>& mine,
-                        const std::vector<uint32_t>& degree, const detail::SharedSticks& sticks, const BinaryVolume& mask,
-                        const std::array<int64_t, 3>& lo, const FlatSegmentation& seg, uint32_t L,
-                        const SharpenOptions& o) {
+// Sharpens label L's view (Section 5, restricted to the cubes it may edit).
+LabelEdit sharpen_label(LabelView v, const FlatSegmentation& seg, const SharpenOptions& o) {
   LabelEdit e;
-  e.label = L;
-  StickSurface surf = extract_sticks(mask);
+  e.label = v.label;
+  e.cubes = v.cubes;
+  if (v.cubes == 0) return e;
+  e.idx = std::move(v.idx);
+  const StickSurface& surf = v.surf;
   const size_t n = surf.stick_count();
-  e.idx.resize(n);
-  for (size_t k = 0; k < n; ++k) {
-    const uint32_t v = sticks.find(surf, k, lo);
-    if (v == UINT32_MAX) throw std::logic_error("sharpen_shared: a label's stick is not on the shared surface");
-    e.idx[k] = v;
-    // Its place as pressed on the shared surface.
-    surf.t[k] = s.lattice.to_index(s.mesh.positions[v])[surf.axis(k)] - double(s.corner[v][size_t(surf.axis(k))]);
-  }
-  // The label's own triangles by cube (shared lattice).
-  std::vector<std::pair<Cube, uint32_t>> own(surf.triangles.size());
-  for (uint32_t f = 0; f < surf.triangles.size(); ++f) {
-    Vec3 g = Vec3::Zero();
-    for (uint32_t k : surf.triangles[f]) {
-      const auto l = surf.lower_index(k);
-      Vec3 c(double(l[0] + lo[0]), double(l[1] + lo[1]), double(l[2] + lo[2]));
-      c[surf.axis(k)] += 0.5;
-      g += c / 3;
-    }
-    own[f] = {floor_of(g), f};
-  }
-  std::vector<Cube> cube(own.size());
-  for (const auto& [c, f] : own) cube[f] = c;
-  std::sort(own.begin(), own.end());
-  // A cube it owns is editable where its shared triangles are its own
-  // binary triangles (oriented outwards from L).
-  std::vector<uint8_t> editable(surf.triangles.size(), 0);
-  std::vector<uint32_t> shared_of(surf.triangles.size(), UINT32_MAX);
-  std::vector<std::pair<Triangle, uint32_t>> a, b;
-  for (uint32_t g : mine) {
-    const Cube& c = cubes.tris[cubes.offsets[g]].first;
-    auto first = std::lower_bound(own.begin(), own.end(), std::pair<Cube, uint32_t>{c, 0});
-    auto last = first;
-    while (last != own.end() && last->first == c) ++last;
-    if (size_t(last - first) != cubes.offsets[g + 1] - cubes.offsets[g]) continue;
-    a.clear();
-    b.clear();
-    for (auto it = first; it != last; ++it) {
-      const Triangle& t = surf.triangles[it->second];
-      a.push_back({canonical({e.idx[t[0]], e.idx[t[1]], e.idx[t[2]]}), it->second});
-    }
-    for (size_t k = cubes.offsets[g]; k < cubes.offsets[g + 1]; ++k) {
-      const uint32_t f = cubes.tris[k].second;
-      Triangle t = s.mesh.triangles[f];
-      if (s.sides[f][0] != L) std::swap(t[1], t[2]);
-      b.push_back({canonical(t), f});
-    }
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    bool same = true;
-    for (size_t i = 0; i < a.size() && same; ++i) same = a[i].first == b[i].first;
-    if (!same) continue;
-    ++e.cubes;
-    for (size_t i = 0; i < a.size(); ++i) {
-      editable[a[i].second] = 1;
-      shared_of[a[i].second] = b[i].second;
-    }
-  }
-  if (e.cubes == 0) return e;
-  // A stick vertex may move only when all its shared triangles are editable.
-  std::vector<uint32_t> count(n, 0);
-  for (uint32_t f = 0; f < surf.triangles.size(); ++f)
-    if (editable[f])
-      for (uint32_t k : surf.triangles[f]) ++count[k];
-  std::vector<uint8_t> fixed(n);
-  for (size_t k = 0; k < n; ++k) fixed[k] = count[k] != degree[e.idx[k]];
   sharpen_impl::Sharpener sh(surf, seg, o);
-  sh.editable = &editable;
-  sh.fixed = &fixed;
+  sh.editable = &v.editable;
+  sh.fixed = &v.fixed;
   e.stats = sh.run().stats;
   e.delta = sh.delta;
-  const Vec3 shift{double(lo[0]), double(lo[1]), double(lo[2])};
+  const Vec3 shift{double(v.lo[0]), double(v.lo[1]), double(v.lo[2])};
   for (size_t k = 0; k < n; ++k)
     if (sh.x[k] != surf.index_position(k))
       e.moved.push_back({e.idx[k], sh.x[k] + shift});
   for (size_t i = 0; i < sh.nv.size(); ++i) {
-    const sharpen_impl::NewVertex& v = sh.nv[i];
+    const sharpen_impl::NewVertex& w = sh.nv[i];
     LabelEdit::Fresh f;
     f.at = sh.x[n + i] + shift;
-    f.corner = v.corner;
-    if (v.corner) {
-      for (int k = 0; k < 3; ++k) f.from[size_t(k)] = v.from[size_t(k)] - uint32_t(n);
+    f.corner = w.corner;
+    if (w.corner) {
+      for (int k = 0; k < 3; ++k) f.from[size_t(k)] = w.from[size_t(k)] - uint32_t(n);
     } else {
-      f.a = v.a, f.b = v.b, f.u = v.u;
+      f.a = w.a, f.b = w.b, f.u = w.u;
     }
     e.fresh.push_back(f);
   }
@@ -184,52 +88,17 @@ LabelEdit sharpen_label(const SharedSurface& s, const CubeGroups& cubes, const s
     size_t j = i;
     while (j < sh.tris.size() && sh.parent[j] == sh.parent[i]) ++j;
     if (j - i > 1) {
-      e.splits.push_back({shared_of[sh.parent[i]], uint32_t(e.children.size()), uint32_t(e.children.size() + j - i)});
+      e.splits.push_back({v.shared_of[sh.parent[i]], uint32_t(e.children.size()), uint32_t(e.children.size() + j - i)});
       for (size_t k = i; k < j; ++k) {
         e.children.push_back(sh.tris[k]);
         for (uint32_t w : sh.tris[k])
-          if (w >= n) e.fresh[w - n].cube = cube[sh.parent[i]];
+          if (w >= n) e.fresh[w - n].cube = v.cube[sh.parent[i]];
       }
     }
     i = j;
   }
   std::sort(e.splits.begin(), e.splits.end(), [](const auto& p, const auto& q) { return p.f < q.f; });
   return e;
-}
-
-// The groups of cubes, and each group's owner: a cube of two labels, all
-// its vertices on sticks, is sharpened by the lower-valued of its labels
-// that has flats (`sharpens`, per label index; never the background).
-CubeGroups group_cubes(const SharedSurface& s, const std::vector<uint8_t>& sharpens) {
-  CubeGroups c;
-  const size_t nt = s.mesh.triangles.size();
-  c.tris.resize(nt);
-  tbb::parallel_for(size_t(0), nt, [&](size_t f) {
-    const Triangle& t = s.mesh.triangles[f];
-    c.tris[f] = {floor_of((element_centre(s, t[0]) + element_centre(s, t[1]) + element_centre(s, t[2])) / 3), uint32_t(f)};
-  });
-  tbb::parallel_sort(c.tris.begin(), c.tris.end());
-  for (size_t i = 1; i <= nt; ++i)
-    if (i == nt || c.tris[i].first != c.tris[i - 1].first) c.offsets.push_back(i);
-  if (nt == 0) c.offsets.assign(1, 0);
-  c.owner.assign(c.offsets.size() - 1, UINT32_MAX);
-  tbb::parallel_for(size_t(0), c.owner.size(), [&](size_t g) {
-    const auto pair = [&](size_t k) {
-      const auto& sd = s.sides[c.tris[k].second];
-      return std::array<uint32_t, 2>{std::min(sd[0], sd[1]), std::max(sd[0], sd[1])};
-    };
-    const auto p = pair(c.offsets[g]);
-    for (size_t k = c.offsets[g]; k < c.offsets[g + 1]; ++k) {
-      if (pair(k) != p) return;
-      for (uint32_t v : s.mesh.triangles[c.tris[k].second])
-        if (s.kind[v] >= 3) return;
-    }
-    uint32_t owner = UINT32_MAX;
-    for (uint32_t l : p)
-      if (l != 0 && sharpens[l] && (owner == UINT32_MAX || s.labels[l] < s.labels[owner])) owner = l;
-    c.owner[g] = owner;
-  });
-  return c;
 }
 
 // Per edit, which of its changes are taken back: its moved vertices, its
@@ -395,25 +264,19 @@ SharedSharpenStats sharpen_shared(SharedSurface& s, const SharedFlats& flats, co
     info_of[size_t(it - s.labels.begin())] = i;
   }
   if (std::find(sharpens.begin(), sharpens.end(), 1) == sharpens.end()) return st;
-  const CubeGroups cubes = group_cubes(s, sharpens);
-  std::vector<std::vector<uint32_t>> mine(s.labels.size());
-  for (uint32_t g = 0; g < cubes.owner.size(); ++g)
-    if (cubes.owner[g] != UINT32_MAX) mine[cubes.owner[g]].push_back(g);
-  std::vector<uint32_t> degree(s.mesh.positions.size(), 0);
-  for (const Triangle& t : s.mesh.triangles)
-    for (uint32_t v : t) ++degree[v];
+  const detail::Ownership own = detail::ownership(s, sharpens);
   const detail::SharedSticks sticks(s);
   std::vector<uint32_t> todo;
   for (uint32_t l = 0; l < s.labels.size(); ++l)
-    if (!mine[l].empty()) todo.push_back(l);
+    if (!own.mine[l].empty()) todo.push_back(l);
   SharpenOptions o = options;
   o.progress = nullptr;
   std::vector<LabelEdit> edits(todo.size());
   tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
     const uint32_t l = todo[i];
     const LabelInfo& info = labels[info_of[l]];
-    edits[i] = sharpen_label(s, cubes, mine[l], degree, sticks, masks(info), detail::mask_origin(info.lo),
-                             flats.segmentations[info_of[l]], l, o);
+    edits[i] = sharpen_label(detail::label_view(s, own, sticks, masks(info), detail::mask_origin(info.lo), l),
+                             flats.segmentations[info_of[l]], o);
   });
   // Applied together and checked against the whole surface. The changes
   // around a triangle that fails are taken back (a new edge vertex with its

@@ -39,12 +39,14 @@ struct FitScratch {
 }  // namespace
 
 QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& region,
-                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& o) {
+                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& o,
+                                   const std::vector<uint8_t>* only) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = s.stick_count();
   if (!region.empty() && region.size() != n) throw std::invalid_argument("fit_local_quadrics: regions do not match the sticks");
   if (!junction.empty() && junction.size() != n)
     throw std::invalid_argument("fit_local_quadrics: junction flags do not match the sticks");
+  if (only && only->size() != n) throw std::invalid_argument("fit_local_quadrics: `only` does not match the sticks");
   QuadricFitStats st;
   if (o.rings <= 0 || n == 0) return st;
   const auto fresh = [&](size_t v) { return (region.empty() || region[v] < 0) && (junction.empty() || !junction[v]); };
@@ -63,9 +65,19 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
   // Each fresh vertex's quadric, when trusted (`fitted`).
   std::vector<StoredQuadric> quad(n);
   std::vector<uint8_t> fitted(n, 0);
+  // With `only`: the quadrics its vertices' moves read (theirs and their neighbours').
+  std::vector<uint8_t> needed;
+  if (only) {
+    needed.assign(n, 0);
+    for (size_t v = 0; v < n; ++v)
+      if ((*only)[v]) {
+        needed[v] = 1;
+        for (uint32_t k = off[v]; k < off[v + 1]; ++k) needed[adj[k]] = 1;
+      }
+  }
   tbb::enumerable_thread_specific<FitScratch> scratch;
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
-    if (!fresh(v)) return;
+    if (!fresh(v) || (only && !needed[v])) return;
     FitScratch& f = scratch.local();
     detail::rings_around(uint32_t(v), uint32_t(o.rings), off, adj, [&](uint32_t w) { return fresh(w); }, f.rings);
     f.pts.clear();
@@ -99,7 +111,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     return q;
   };
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
-    if (!fitted[v]) return;
+    if (!fitted[v] || (only && !(*only)[v])) return;
     const bool lower_in = s.lower_inside(v);
     const Vec3 in = inside(v), out = outside(v);
     const double own = detail::stab(quadric(v), in, out, lower_in ? s.t[v] : 1 - s.t[v], o.margin);

@@ -61,6 +61,30 @@ TEST(SharedPress, PressedPhantomKeepsEveryGuarantee) {
   EXPECT_LT(sphere3_rms(pressed3), 0.5 * sphere3_rms(mid3));
 }
 
+// The quadric fit (shared_fit.h): the nested sphere's cubes belong to it
+// (the higher label), so its surface is its binary press and fit; every
+// label keeps every guarantee.
+TEST(SharedFit, NestedSphereGetsItsBinaryFit) {
+  const ScalarVolume v = test::phantom();
+  SurfaceOptions o;
+  o.passes.disable(Pass::flats);
+  const SharedLabels r = press_shared_labels(v, label_table(v), o);
+  EXPECT_GT(r.fit.moved, 0u);
+  EXPECT_EQ(r.fit.labels, 4u);
+  for (uint32_t L = 1; L < r.surface.labels.size(); ++L) {
+    SCOPED_TRACE("label " + std::to_string(r.surface.labels[L]));
+    test::expect_guarantees(label_mesh(r.surface, L), test::whole_mask(v, double(r.surface.labels[L])));
+  }
+  StickSurface binary = extract_sticks(test::whole_mask(v, 3));
+  press(binary);
+  const double pressed = sphere3_rms(to_mesh(binary));
+  EXPECT_GT(fit_local_quadrics(binary, {}, {}).moved, 0u);
+  // The same fit up to the rounding of t read back from physical positions
+  // (and not the press alone: the fit moved it).
+  EXPECT_NEAR(sphere3_rms(label_mesh(r.surface, 3)), sphere3_rms(to_mesh(binary)), 1e-6);
+  EXPECT_GT(std::abs(sphere3_rms(to_mesh(binary)) - pressed), 1e-4);
+}
+
 // Every label of the pressed surface keeps every guarantee (double and
 // float32), and pressing moved the surface.
 void expect_pressed(const ScalarVolume& v) {
@@ -101,15 +125,19 @@ TEST(SharedPress, AdversarialLabelConfigurationsKeepEveryGuarantee) {
   }
 }
 
-// The 61-label TotalSegmentator map: every label closed, 2-manifold,
-// oriented, free of self-intersection, 0 violations, in double and float32.
+// The 61-label TotalSegmentator map as press --labels makes it: every label
+// closed, 2-manifold, oriented, free of self-intersection, 0 violations, in
+// double and float32.
 TEST(SharedPress, SixtyOneLabelMap) {
   const std::string path = test::shared_data() + "/medical/totalseg_example_seg_fast_force_split.nii.gz";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared is absent: " << path;
   const ScalarVolume v = read_volume(path);
-  SharedSurface s = extract_shared_surface(v);
-  const SharedPressStats st = press_shared(s);
-  EXPECT_GT(st.junction_moving, 0u);
+  // What press --labels does: press, flats, quadric fit, sharpening.
+  const SharedLabels r = press_shared_labels(v, label_table(v), SurfaceOptions{});
+  const SharedSurface& s = r.surface;
+  EXPECT_GT(r.press.junction_moving, 0u);
+  EXPECT_GT(r.fit.moved, 0u);
+  EXPECT_GT(r.sharpen.inserted, 0u) << "the field of view's cut is sharpened";
   for (uint32_t L = 1; L < s.labels.size(); ++L) {
     SCOPED_TRACE("label " + std::to_string(s.labels[L]));
     test::expect_guarantees(label_mesh(s, L), test::whole_mask(v, double(s.labels[L])));

@@ -35,6 +35,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "voxpress/labels/shared_fit.h"
 #include "voxpress/labels/shared_flats.h"
 #include "voxpress/labels/shared_sharpen.h"
 #include "voxpress/labels/shared_surface.h"
@@ -66,13 +67,16 @@ SharedPressStats press_shared(SharedSurface& surface, const PressOptions& option
 /// What `press --labels` and Python's press_labels() do by default: the
 /// shared surface of `volume` (whose labels and boxes `table` lists),
 /// each label's flats when options.passes has them, pressed by
-/// options.press (with options.overrides), then sharpened where labels have
-/// flats (options.sharp, Pass::sharpen; shared_sharpen.h). Throws InputError when float32
+/// options.press (with options.overrides), fitted (options.fit,
+/// Pass::quadric_fit; shared_fit.h), then sharpened where labels have flats
+/// (options.sharp, Pass::sharpen; shared_sharpen.h): smooth_surface's
+/// stages, on the shared surface. Throws InputError when float32
 /// output could not keep every sample on its side (require_float32_room).
 struct SharedLabels {
   SharedSurface surface;
   std::optional<SharedFlats> flats;  ///< empty with --no-flats
   SharedPressStats press;
+  SharedFitStats fit;          ///< when options.passes has Pass::quadric_fit
   SharedSharpenStats sharpen;  ///< labels with flats, when options.passes has Pass::sharpen
   double seconds_extract = 0;
 };

@@ -5,7 +5,9 @@
 // L's own mask: where the shared label case there is L's binary case (the
 // same triangles, compared stick by stick), L's binary sharpening may edit
 // it. Each such cube is sharpened by one label, its owner: of L and X, the
-// lower-valued label that has flats (the background never). For each label
+// higher-valued label that has flats (the background never; the label cases
+// put the higher label inside a two-label face, so its binary case is the
+// shared one by construction, ambiguous faces included). For each label
 // with flats, its own surface (extract_sticks of its mask, every t read
 // from the pressed shared surface) goes through sharpen() with its binary
 // segmentation (find_shared_flats keeps it), restricted to its cubes:

@@ -156,8 +156,12 @@ struct QuadricFitStats {
   double seconds = 0;
 };
 
+/// `only` (optional, per stick): the vertices that may move; only their
+/// quadrics and their neighbours' are fitted (a label's part of a shared
+/// surface, shared_fit.h). The result is the same for them as without.
 QuadricFitStats fit_local_quadrics(StickSurface& surface, const std::vector<int32_t>& region,
-                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& options = {});
+                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& options = {},
+                                   const std::vector<uint8_t>* only = nullptr);
 
 // ----------------------------------------------------------------- 2D
 /// A binary image's contours, pressed: the 2D counterpart, through the same
