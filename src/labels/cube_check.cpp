@@ -12,7 +12,7 @@
 
 namespace voxpress::detail {
 
-Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0) {
+Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0, const std::vector<uint8_t>* only) {
   Cubes c;
   const size_t nt = m.triangles.size();
   std::vector<std::pair<std::array<int64_t, 3>, uint32_t>> key(nt);
@@ -30,7 +30,8 @@ Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0) {
   std::vector<std::pair<uint32_t, uint32_t>> vg;  // (vertex, group)
   for (uint32_t g = 0; g + 1 < c.offsets.size(); ++g)
     for (uint32_t k = c.offsets[g]; k < c.offsets[g + 1]; ++k)
-      for (uint32_t v : m.triangles[c.tris[k]]) vg.push_back({v, g});
+      for (uint32_t v : m.triangles[c.tris[k]])
+        if (!only || (*only)[v]) vg.push_back({v, g});
   tbb::parallel_sort(vg.begin(), vg.end());
   vg.erase(std::unique(vg.begin(), vg.end()), vg.end());
   c.vertex_offsets.assign(x0.size() + 1, 0);

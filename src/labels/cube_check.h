@@ -22,8 +22,9 @@ struct Cubes {
   std::vector<uint32_t> vertex_offsets, vertex_groups;
 };
 
-/// The cubes of `m`'s triangles, `x0` the vertices' element centres (index space).
-Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0);
+/// The cubes of `m`'s triangles, `x0` the vertices' element centres (index
+/// space); the groups of the vertices `only` flags (null: all).
+Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0, const std::vector<uint8_t>* only = nullptr);
 
 /// The groups among `groups` (increasing) whose triangles, at index-space
 /// positions `x`, degenerate, have an altitude under delta (cells), or meet

@@ -78,7 +78,9 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
       reset[v] = 0;
     }
   }
-  const detail::Cubes cubes = detail::cubes_of(s.mesh, x0);
+  std::vector<uint8_t> moved(n);
+  for (size_t v = 0; v < n; ++v) moved[v] = !reset[v];
+  const detail::Cubes cubes = detail::cubes_of(s.mesh, x0, &moved);  // put_back visits moved vertices only
   std::vector<uint32_t> touched;
   for (uint32_t v = 0; v < n; ++v)
     if (!reset[v])
