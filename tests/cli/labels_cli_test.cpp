@@ -108,6 +108,16 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
       << out;
   EXPECT_FALSE(nlohmann::json::parse(test::read_file(tmp.path("alone/labels.json")))["shared"].get<bool>());
   EXPECT_FALSE(fs::exists(tmp.path("alone/interfaces.ply")));
+  // The shared surface is fitted and sharpened like one label alone;
+  // --no-sharpen keeps its chamfers.
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --no-sharpen --stats-json " +
+                        tmp.path("ns.json") + " -o " + tmp.path("chamfered"),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json ns = nlohmann::json::parse(test::read_file(tmp.path("ns.json")))["shared_surface"];
+  EXPECT_EQ(ns["sharpen"]["crease_vertices"].get<size_t>(), 0u);
+  EXPECT_EQ(ns["quadric_fit"]["labels"].get<size_t>(), 3u);
   // Region colours need --separate (the shared surface has none); --separate
   // needs --labels.
   EXPECT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --color-regions -o " + tmp.path("none"), &out), 2);

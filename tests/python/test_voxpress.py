@@ -251,6 +251,9 @@ def test_press_labels_every_label_at_once(tmp_path):
     assert not alone[9].stats["shared"] and alone[9].stats["flats"] >= 0
     with pytest.raises(voxpress.UsageError, match="separate"):
         voxpress.press_labels(labels, color_regions=True)
+    # The shared surface is fitted and sharpened as one label alone would be; sharpen=False keeps the chamfers.
+    _, chamfered = voxpress.press_labels(labels, spacing=(1, 1, 1.5), sharpen=False, interfaces=True)
+    assert chamfered.stats["crease_vertices"] == 0 and chamfered.stats["fitted_vertices"] >= 0
     # Flats of the shared surface can be turned off: the plain shared press.
     plain, plain_shared = voxpress.press_labels(labels, spacing=(1, 1, 1.5), flats=False, interfaces=True)
     assert plain_shared.stats["flats"] == 0 and plain_shared.stats["flat_vertices"] == 0
