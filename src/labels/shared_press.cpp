@@ -8,6 +8,8 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -29,6 +31,11 @@ using detail::kNone;
 
 bool is_stick(uint8_t kind) { return kind < 3; }
 bool is_face(uint8_t kind) { return kind >= 3 && kind < 6; }
+// Planes closer to parallel than this (1 - cos, ~10 degrees) pin one direction only.
+constexpr double kPlaneFloor = 0.015;
+// Cells: planes meeting farther than this outside a junction vertex's element
+// are about another edge of the parts; the vertex is left to the junction press.
+constexpr double kBeyond = 0.5;
 
 // The plane of family a (normal to axis a) a vertex lies in, or INT64_MIN.
 int64_t plane_of(const SharedSurface& s, uint32_t v, int a) {
@@ -254,6 +261,70 @@ std::vector<int64_t> continuations(const SharedSurface& s, const Chains& c, cons
   return partner;
 }
 
+
+// Beyond the paper (CAD assemblies): a junction vertex next to stick
+// vertices on flats lies where those flats' planes meet — a line where two
+// parts' faces meet at an edge. Where the planes pin every free coordinate
+// of its element (a stick's t; a face's two in-plane coordinates; an apex's
+// three), it goes to their least-squares point in the element, kept inside
+// by the margin, and stays there as a fixed point of both stages. Planes
+// that leave a direction free (one face plane across a face vertex: its
+// place along the line is the junction press's to find) place nothing.
+// Returns per vertex: 1 when it has such a place (`target`).
+std::vector<uint8_t> flat_places(const SharedSurface& s, const SharedFlats& flats, const std::vector<Edge>& edges,
+                                 const std::vector<uint32_t>& members, const std::vector<Vec3>& x0, double margin,
+                                 std::vector<Vec3>& target) {
+  const size_t n = s.mesh.positions.size();
+  std::vector<std::pair<uint32_t, uint32_t>> all;
+  for (const Edge& e : edges) all.push_back({e.u, e.v});
+  const Graph g(n, all);
+  const Mat3 Mt = s.lattice.index_to_physical_matrix().transpose();
+  std::vector<uint8_t> placed(n, 0);
+  target.assign(n, Vec3::Zero());
+  tbb::parallel_for(size_t(0), members.size(), [&](size_t i) {
+    const uint32_t v = members[i];
+    std::vector<int32_t> regions;
+    for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k)
+      if (const int32_t r = flats.region[g.to[k]]; r >= 0 && is_stick(s.kind[g.to[k]])) regions.push_back(r);
+    std::sort(regions.begin(), regions.end());
+    regions.erase(std::unique(regions.begin(), regions.end()), regions.end());
+    if (regions.empty()) return;
+    // The element's free coordinates (mask), the planes restricted to them.
+    const uint8_t kind = s.kind[v];
+    Vec3 free = Vec3::Zero();
+    for (int a = 0; a < 3; ++a)
+      free[a] = kind == 6 || (is_stick(kind) && kind == a) || (is_face(kind) && kind - 3 != a) ? 1 : 0;
+    Mat3 A = Mat3::Zero();
+    Vec3 r = Vec3::Zero();
+    for (int32_t f : regions) {  // the plane in index space: (M^T n) . x = offset - n . origin
+      const Flat& F = flats.flats[size_t(f)];
+      const Vec3 nn = Mt * F.normal;
+      const double len = nn.norm(), c = (F.offset - F.normal.dot(s.lattice.origin)) / len;
+      const Vec3 u = nn / len, uf = u.cwiseProduct(free);
+      A += uf * uf.transpose();
+      r += uf * (c - u.dot(x0[v]));
+    }
+    Eigen::SelfAdjointEigenSolver<Mat3> es(A);
+    Vec3 y = x0[v];
+    int pinned = 0;
+    for (int k = 0; k < 3; ++k)
+      if (es.eigenvalues()[k] > kPlaneFloor) {
+        y += es.eigenvectors().col(k) * (es.eigenvectors().col(k).dot(r) / es.eigenvalues()[k]);
+        ++pinned;
+      }
+    if (pinned < free.sum()) return;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = double(s.corner[v][size_t(a)]);
+      if (free[a] == 0) continue;
+      if (y[a] < lo - kBeyond || y[a] > lo + 1 + kBeyond) return;  // the planes meet elsewhere
+      y[a] = std::clamp(y[a], lo + margin, lo + 1 - margin);
+    }
+    target[v] = y;
+    placed[v] = 1;
+  });
+  return placed;
+}
+
 }  // namespace
 
 SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const SharedFlats* flats) {
@@ -399,6 +470,9 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   const double delta = detail::float32_clearance(s.lattice);
   std::vector<uint32_t> all(cubes.offsets.size() - 1);
   for (uint32_t g = 0; g < all.size(); ++g) all[g] = g;
+  std::vector<Vec3> place;
+  const std::vector<uint8_t> placed =
+      flats ? flat_places(s, *flats, edges, members, x0, o.margin, place) : std::vector<uint8_t>(n, 0);
   // One pressing of both stages; `pinned` vertices keep their midpoint place.
   std::vector<Vec3> x;
   std::vector<uint8_t> pinned(n, 0);
@@ -406,9 +480,14 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
     x = x0;
     std::vector<double> t = t0s;
     std::vector<uint8_t> moving(n, 0), stop(n, 0);
-    st.junction_moving = st.junction_fixed = 0;
+    st.junction_moving = st.junction_fixed = st.junction_on_flats = 0;
     for (uint32_t v : members) {
-      moving[v] = jg.degree(v) == 2 && !is_stick(s.kind[v]) && count[v] < 4 && !pinned[v];
+      if (placed[v] && !pinned[v]) {
+        x[v] = place[v];
+        if (is_stick(s.kind[v])) t[v] = place[v][s.kind[v]] - double(s.corner[v][s.kind[v]]);
+        ++st.junction_on_flats;
+      }
+      moving[v] = jg.degree(v) == 2 && !is_stick(s.kind[v]) && count[v] < 4 && !pinned[v] && !placed[v];
       stop[v] = !moving[v];
       (moving[v] ? st.junction_moving : st.junction_fixed)++;
     }
@@ -428,7 +507,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
     }
     st.interfaces = detail::iterate(t, families, 2, frozen, barrier, o, levels);
     tbb::parallel_for(size_t(0), n, [&](size_t v) {
-      if (!is_stick(s.kind[v]) || jg.degree(v) > 0) return;  // junction sticks stay at x0
+      if (!is_stick(s.kind[v]) || jg.degree(v) > 0) return;  // junction sticks stay where stage 1 put them
       Vec3 y(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
       y[s.kind[v]] += t[v];
       x[v] = y;

@@ -8,6 +8,9 @@
 //     bilaplacian on arc length, each face-centre vertex kept inside its
 //     face square, each apex inside its cube. Points where a line branches
 //     or ends, and vertices around which four or more labels meet, stay fixed.
+//     With flats (CAD assemblies), a junction vertex whose neighbours' flats
+//     pin every free coordinate of its element (two parts' faces meeting at
+//     an edge) is placed where those planes meet and stays there.
 //  2. Interfaces. On each lattice plane the surface's cut is a network of
 //     labelled contours: curves of stick vertices between junction points
 //     (the face-centre vertices of the plane's faces). Every curve is
@@ -47,6 +50,7 @@ struct SharedPressStats {
   size_t junction_curves = 0;    ///< junction lines (open between fixed points, or closed)
   size_t junction_moving = 0;    ///< their vertices that move
   size_t junction_fixed = 0;     ///< junction vertices kept in place (branch and end points, 4+ labels)
+  size_t junction_on_flats = 0;  ///< junction vertices placed where their neighbours' flats meet
   size_t plane_curves = 0;       ///< pieces of labelled contours and closed contours on the planes
   size_t continued = 0;          ///< pieces pressed on through a junction point into the piece continuing them
   size_t cubes_pinned = 0;       ///< cubes that failed the exact check and were pressed again pinned
