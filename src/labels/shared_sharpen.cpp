@@ -4,13 +4,11 @@
 #include "voxpress/labels/shared_sharpen.h"
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "core/clearance.h"
 #include "core/predicates.h"
 #include "core/timing.h"
 #include "features/sharpener.h"

@@ -23,10 +23,12 @@
 // labels (X's surface gets L's creases reversed). Then every changed
 // triangle is checked exactly against every shared triangle near it (other
 // labels' interfaces, junction cubes the sharpener saw as L's binary
-// case), with the float32 clearance; a label whose sharpening meets
-// anything is undone whole, so the surface keeps every guarantee of
-// press_shared. Deterministic: labels sharpened in parallel, applied in
-// label order.
+// case), with the float32 clearance. The changes around a triangle that
+// fails are taken back (a new vertex onto the edge it was inserted on, a
+// moved stick vertex to its place) and the check runs again, until none
+// fails; a label with nothing left to take back is undone whole. So the
+// surface keeps every guarantee of press_shared. Deterministic: labels
+// sharpened in parallel, applied in label order.
 #pragma once
 
 #include <cstddef>
