@@ -2,6 +2,8 @@
 // Ericson, Real-Time Collision Detection (2005), Sections 5.1.5 and 5.1.9.
 #include "core/clearance.h"
 
+#include "core/predicates.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -134,6 +136,15 @@ bool triangles_within(const Vec3 (&ta)[3], const uint32_t (&ia)[3], const Vec3 (
     return false;
   }
   return edge_near(ta[own_a[0]], ta[own_a[1]], B) || edge_near(tb[own_b[0]], tb[own_b[1]], A);
+}
+
+bool triangle_too_thin(const Vec3& a, const Vec3& b, const Vec3& c, double d) {
+  return triangle_degenerate(a, b, c) || triangle_altitude(a, b, c) < d;
+}
+
+bool triangles_clash(const Vec3 (&ta)[3], const uint32_t (&ia)[3], const Vec3 (&tb)[3], const uint32_t (&ib)[3],
+                     double d) {
+  return triangles_intersect(ta, ia, tb, ib) || triangles_within(ta, ia, tb, ib, d);
 }
 
 }  // namespace voxpress::detail

@@ -45,4 +45,11 @@ double triangle_altitude(const Vec3& a, const Vec3& b, const Vec3& c);
 bool triangles_within(const Vec3 (&ta)[3], const uint32_t (&ia)[3], const Vec3 (&tb)[3], const uint32_t (&ib)[3],
                       double d);
 
+/// The checks every move keeps for float32 output: a triangle that
+/// degenerates or has an altitude under d is too thin; two mesh triangles
+/// that meet beyond what they share, or come within d, clash.
+bool triangle_too_thin(const Vec3& a, const Vec3& b, const Vec3& c, double d);
+bool triangles_clash(const Vec3 (&ta)[3], const uint32_t (&ia)[3], const Vec3 (&tb)[3], const uint32_t (&ib)[3],
+                     double d);
+
 }  // namespace voxpress::detail

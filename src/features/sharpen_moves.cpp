@@ -188,7 +188,7 @@ bool Sharpener::allowed(uint32_t v, const Vec3& q) const {
     const Vec3& b = x[t[size_t((i + 2) % 3)]];
     const Vec3 nn = (a - q).cross(b - q);
     if (!(nn.squaredNorm() > 1e-20) || nn.dot((a - p).cross(b - p)) <= 0) return false;  // turned over
-    if (detail::triangle_degenerate(q, a, b) || detail::triangle_altitude(q, a, b) < delta) return false;
+    if (detail::triangle_too_thin(q, a, b, delta)) return false;
     lo = lo.cwiseMin(a).cwiseMin(b);
     hi = hi.cwiseMax(a).cwiseMax(b);
     // No lattice sample in the swept tetrahedron (p, q, a, b), nor within
@@ -211,7 +211,7 @@ bool Sharpener::allowed(uint32_t v, const Vec3& q) const {
     const Vec3 alo = ta[0].cwiseMin(ta[1]).cwiseMin(ta[2]), ahi = ta[0].cwiseMax(ta[1]).cwiseMax(ta[2]);
     const Vec3 blo = tb[0].cwiseMin(tb[1]).cwiseMin(tb[2]), bhi = tb[0].cwiseMax(tb[1]).cwiseMax(tb[2]);
     if ((alo.array() > bhi.array() + delta).any() || (blo.array() > ahi.array() + delta).any()) return false;
-    return detail::triangles_intersect(ta, ia, tb, ib) || detail::triangles_within(ta, ia, tb, ib, delta);
+    return detail::triangles_clash(ta, ia, tb, ib, delta);
   };
   for (uint32_t k = fan_off[v]; k < fan_off[v + 1]; ++k)
     for (uint32_t k2 = k + 1; k2 < fan_off[v + 1]; ++k2) {

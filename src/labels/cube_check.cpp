@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/predicates.h"
+#include "core/clearance.h"
 
 namespace voxpress::detail {
 
@@ -47,14 +47,13 @@ bool cube_ok(const Mesh& m, const Cubes& c, uint32_t g, const std::vector<Vec3>&
   for (uint32_t i = c.offsets[g]; i < c.offsets[g + 1]; ++i) {
     const Triangle& a = m.triangles[c.tris[i]];
     const Vec3 pa[3] = {x[a[0]], x[a[1]], x[a[2]]};
-    if (triangle_degenerate(pa[0], pa[1], pa[2]) || triangle_altitude(pa[0], pa[1], pa[2]) < delta)
-      return false;
+    if (triangle_too_thin(pa[0], pa[1], pa[2], delta)) return false;
     const uint32_t ia[3] = {a[0], a[1], a[2]};
     for (uint32_t j = c.offsets[g]; j < i; ++j) {
       const Triangle& b = m.triangles[c.tris[j]];
       const Vec3 pb[3] = {x[b[0]], x[b[1]], x[b[2]]};
       const uint32_t ib[3] = {b[0], b[1], b[2]};
-      if (triangles_intersect(pa, ia, pb, ib) || triangles_within(pa, ia, pb, ib, delta)) return false;
+      if (triangles_clash(pa, ia, pb, ib, delta)) return false;
     }
   }
   return true;

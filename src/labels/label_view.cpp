@@ -24,6 +24,15 @@ Cube floor_of(const Vec3& p) {
   return {int64_t(std::floor(p[0])), int64_t(std::floor(p[1])), int64_t(std::floor(p[2]))};
 }
 
+std::vector<size_t> listed_labels(const SharedSurface& s, const std::vector<LabelInfo>& labels) {
+  std::vector<size_t> at(s.labels.size(), SIZE_MAX);
+  for (size_t i = 0; i < labels.size(); ++i) {
+    const auto it = std::lower_bound(s.labels.begin(), s.labels.end(), uint32_t(labels[i].value));
+    if (it != s.labels.end() && it != s.labels.begin() && double(*it) == labels[i].value) at[size_t(it - s.labels.begin())] = i;
+  }
+  return at;
+}
+
 Vec3 element_centre(const SharedSurface& s, uint32_t v) {
   Vec3 p(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
   const int k = s.kind[v];

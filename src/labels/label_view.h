@@ -13,6 +13,7 @@
 #include "shared_sticks.h"
 #include "voxpress/core/volume.h"
 #include "voxpress/extract/sticks.h"
+#include "voxpress/labels/labels.h"
 #include "voxpress/labels/shared_surface.h"
 
 namespace voxpress::detail {
@@ -22,6 +23,10 @@ using Cube = std::array<int64_t, 3>;
 Cube floor_of(const Vec3& p);
 /// Index-space centre of a shared vertex's element (stick, face or cube).
 Vec3 element_centre(const SharedSurface& s, uint32_t v);
+
+/// Per label index of `s`: the position in `labels` of the label of that
+/// value, or SIZE_MAX (the background and labels not listed).
+std::vector<size_t> listed_labels(const SharedSurface& s, const std::vector<LabelInfo>& labels);
 
 /// The shared triangles grouped by the cube they lie in, and who owns each
 /// cube: a cube of two labels, all its vertices on sticks, belongs to the

@@ -21,14 +21,9 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
   SharedFitStats st;
   if (options.rings <= 0) return st;
   // Every label of `labels` takes part (by its index in s.labels).
+  const std::vector<size_t> info_of = detail::listed_labels(s, labels);
   std::vector<uint8_t> takes_part(s.labels.size(), 0);
-  std::vector<size_t> info_of(s.labels.size(), SIZE_MAX);
-  for (size_t i = 0; i < labels.size(); ++i) {
-    const auto it = std::lower_bound(s.labels.begin(), s.labels.end(), uint32_t(labels[i].value));
-    if (it == s.labels.end() || double(*it) != labels[i].value || it == s.labels.begin()) continue;
-    takes_part[size_t(it - s.labels.begin())] = 1;
-    info_of[size_t(it - s.labels.begin())] = i;
-  }
+  for (size_t l = 0; l < s.labels.size(); ++l) takes_part[l] = info_of[l] != SIZE_MAX;
   const detail::Ownership own = detail::ownership(s, takes_part);
   const detail::SharedSticks sticks(s);
   std::vector<uint32_t> todo;

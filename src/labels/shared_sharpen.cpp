@@ -9,7 +9,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/predicates.h"
+#include "core/clearance.h"
 #include "core/timing.h"
 #include "features/sharpener.h"
 #include "label_view.h"
@@ -224,7 +224,7 @@ std::vector<uint8_t> failing(const SharedSurface& s, const std::vector<Changed>&
     const Triangle& a = tris[f];
     const Vec3 pa[3] = {x[a[0]], x[a[1]], x[a[2]]};
     const uint32_t ia[3] = {a[0], a[1], a[2]};
-    if (detail::triangle_degenerate(pa[0], pa[1], pa[2]) || detail::triangle_altitude(pa[0], pa[1], pa[2]) < d) {
+    if (detail::triangle_too_thin(pa[0], pa[1], pa[2], d)) {
       bad[k] = 1;
       return;
     }
@@ -238,7 +238,7 @@ std::vector<uint8_t> failing(const SharedSurface& s, const std::vector<Changed>&
         const Triangle& b = tris[it->second];
         const Vec3 pb[3] = {x[b[0]], x[b[1]], x[b[2]]};
         const uint32_t ib[3] = {b[0], b[1], b[2]};
-        bad[k] = detail::triangles_intersect(pa, ia, pb, ib) || detail::triangles_within(pa, ia, pb, ib, d);
+        bad[k] = detail::triangles_clash(pa, ia, pb, ib, d);
       }
     });
   });
@@ -252,15 +252,10 @@ SharedSharpenStats sharpen_shared(SharedSurface& s, const SharedFlats& flats, co
   const auto t0 = std::chrono::steady_clock::now();
   SharedSharpenStats st;
   // The labels with flats, by their index in s.labels.
+  const std::vector<size_t> info_of = detail::listed_labels(s, labels);
   std::vector<uint8_t> sharpens(s.labels.size(), 0);
-  std::vector<size_t> info_of(s.labels.size(), SIZE_MAX);
-  for (size_t i = 0; i < labels.size() && i < flats.segmentations.size(); ++i) {
-    if (flats.segmentations[i].flats.empty()) continue;
-    const auto it = std::lower_bound(s.labels.begin(), s.labels.end(), uint32_t(labels[i].value));
-    if (it == s.labels.end() || double(*it) != labels[i].value) continue;
-    sharpens[size_t(it - s.labels.begin())] = 1;
-    info_of[size_t(it - s.labels.begin())] = i;
-  }
+  for (size_t l = 0; l < s.labels.size(); ++l)
+    sharpens[l] = info_of[l] < flats.segmentations.size() && !flats.segmentations[info_of[l]].flats.empty();
   if (std::find(sharpens.begin(), sharpens.end(), 1) == sharpens.end()) return st;
   const detail::Ownership own = detail::ownership(s, sharpens);
   const detail::SharedSticks sticks(s);
