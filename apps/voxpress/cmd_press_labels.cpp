@@ -186,11 +186,12 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   if (o.chunks && options.method != Method::pressing) throw UsageError("--chunk with --labels runs --method pressing only");
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
+  // The names first: a bad table is refused before the volume is read.
+  const auto names = o.names_file.empty() ? std::map<double, std::string>{} : read_label_names(o.names_file);
   LabelSource src = open_labels(input, in, o, g, bar.get());
   if (src.volume) src.masks = masks_in(*src.volume);
   LabelTable& table = src.table;
   if (!o.names_file.empty()) {
-    const auto names = read_label_names(o.names_file);
     for (LabelInfo& l : table.labels)
       if (auto it = names.find(l.value); it != names.end()) l.name = it->second;
   }
