@@ -96,8 +96,9 @@ T field(const std::vector<unsigned char>& b, size_t at, bool swap) {
 
 // Validates what nifti_clib relies on: the header size (and from it the
 // version and byte order), dim[0] in 1..7, positive extents, a known data
-// type and a sane data offset.
-void check_header(const std::string& path) {
+// type and a sane data offset; and that no field placing or scaling the
+// samples is infinite or NaN. Returns vox_offset.
+uint64_t check_header(const std::string& path) {
   const auto b = head_bytes(path, 540);
   if (b.size() < 348) throw InputError(path, "truncated: too small for a NIfTI header");
   const int32_t size = field<int32_t>(b, 0, false), swapped = field<int32_t>(b, 0, true);
@@ -118,8 +119,33 @@ void check_header(const std::string& path) {
   const int dt = field<int16_t>(b, v2 ? 12 : 70, swap);
   (void)from_datatype(path, dt);
   const double offset = v2 ? double(field<int64_t>(b, 168, swap)) : double(field<float>(b, 108, swap));
-  if (!(offset >= 0 && offset < 0x1p40))
-    throw InputError(path, "invalid NIfTI header: vox_offset is " + std::to_string(offset));
+  if (!(offset >= 0 && offset < 0x1p40) || offset != std::floor(offset))
+    throw InputError(path, "invalid NIfTI header: vox_offset is " + format_double(offset));
+  // Every value that places or scales the samples must be a number: nifti_clib
+  // would replace an infinite offset by 0 or drop a NaN scaling (issue 73).
+  auto real = [&](size_t at1, size_t at2) { return v2 ? field<double>(b, at2, swap) : double(field<float>(b, at1, swap)); };
+  auto require_finite = [&](const std::string& name, double x) {
+    if (!std::isfinite(x)) throw InputError(path, "invalid NIfTI header: " + name + " is " + format_double(x));
+  };
+  for (int d = 1; d <= std::min<int64_t>(dim[0], 3); ++d)
+    require_finite("pixdim[" + std::to_string(d) + "]", real(76 + 4 * size_t(d), 104 + 8 * size_t(d)));
+  const char* axis = "xyz";
+  for (size_t a = 0; a < 3; ++a) {
+    require_finite(std::string("quatern_") + "bcd"[a], real(256 + 4 * a, 352 + 8 * a));
+    require_finite(std::string("qoffset_") + axis[a], real(268 + 4 * a, 376 + 8 * a));
+    for (size_t c = 0; c < 4; ++c)
+      require_finite(std::string("srow_") + axis[a] + "[" + std::to_string(c) + "]",
+                     real(280 + 16 * a + 4 * c, 400 + 32 * a + 8 * c));
+  }
+  // Scaling: a slope of 0 means none (the standard), as does nibabel's NaN
+  // slope with a NaN or zero intercept; any other non-finite value is refused.
+  const double slope = real(112, 176), inter = real(116, 184);
+  const bool unscaled_nan = std::isnan(slope) && (std::isnan(inter) || inter == 0);
+  if (!unscaled_nan) {
+    require_finite("scl_slope", slope);
+    if (slope != 0) require_finite("scl_inter", inter);
+  }
+  return uint64_t(offset);
 }
 
 }  // namespace
@@ -129,9 +155,17 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   const uint64_t fsize = file_size(path);
   const std::string ext = extension_of(path);
   if (ext != ".nii.gz" && fsize < 348) throw InputError(path, "truncated: too small for a NIfTI header");
-  check_header(path);
+  const uint64_t vox_offset = check_header(path);
   NimPtr nim(nifti_image_read(path.c_str(), 0));
   if (!nim) throw InputError(path, "not a readable NIfTI-1/2 file (bad or truncated header)");
+  // nifti_clib reads from the end of the header when vox_offset does not fit
+  // its int (1e12): the data would come from the wrong place (issue 73).
+  const bool single = nim->iname && nim->fname && std::strcmp(nim->iname, nim->fname) == 0;
+  if (single && vox_offset > uint64_t(nim->iname_offset))
+    throw InputError(path, "invalid NIfTI header: vox_offset " + std::to_string(vox_offset) +
+                               (ext == ".nii" && vox_offset > fsize ? " is beyond the end of the file (" +
+                                                                          std::to_string(fsize) + " bytes)"
+                                                                    : " cannot be honoured"));
   ScalarVolume v;
   v.source = path;
   for (int d = 4; d <= 7; ++d)
@@ -145,7 +179,7 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   if (uint64_t(nim->nvox) != count) throw InputError(path, "inconsistent NIfTI dimensions");
   check_limit(path, count * vs, max_bytes, "the volume");
   // For an uncompressed single file the payload size is known up front.
-  if (ext == ".nii" && nim->iname && std::strcmp(nim->iname, nim->fname) == 0) {
+  if (ext == ".nii" && single) {
     const uint64_t need = uint64_t(nim->iname_offset) + count * vs;
     if (fsize < need)
       throw InputError(path, "truncated: the header declares " + std::to_string(count * vs) + " bytes of data at offset " +

@@ -247,10 +247,13 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     if (int64_t(tok.size()) != dim) throw InputError(path, "'spacings' does not list 'dimension' values");
     for (int a = 0; a < dim - first; ++a) {
       const double s = parse_double(path, tok[size_t(first + a)], "spacings");
-      if (std::isfinite(s) && s != 0) {
-        v.lattice.spacing[a] = std::abs(s);
-        if (s < 0) v.lattice.direction.col(a) *= -1;
-      }
+      // No silent default: a spatial axis's spacing is a finite non-zero number
+      // (negative flips the axis, as teem reads it) (issue 73).
+      if (!std::isfinite(s) || s == 0)
+        throw InputError(path, "'spacings' gives spatial axis " + std::to_string(first + a) + " the spacing " +
+                                   tok[size_t(first + a)] + " (must be a finite non-zero number)");
+      v.lattice.spacing[a] = std::abs(s);
+      if (s < 0) v.lattice.direction.col(a) *= -1;
     }
   }
   if (const auto* o = field(h, {"space origin"})) {
@@ -294,6 +297,13 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
   int64_t line_skip = 0, byte_skip = 0;
   if (const auto* s = field(h, {"line skip", "lineskip"})) line_skip = parse_int(path, *s, "line skip");
   if (const auto* s = field(h, {"byte skip", "byteskip"})) byte_skip = parse_int(path, *s, "byte skip");
+  // -1 (the data is the file's last bytes) is the one negative value NRRD
+  // defines, for raw data only; -5 was read as 0 (issue 73).
+  if (line_skip < 0) throw InputError(path, "'line skip' is " + std::to_string(line_skip) + " (must be 0 or more)");
+  if (byte_skip < -1 || (byte_skip == -1 && enc != "raw"))
+    throw InputError(path, "'byte skip' is " + std::to_string(byte_skip) +
+                               (byte_skip == -1 ? " with " + enc + " encoding (-1 applies to raw data only)"
+                                                : " (must be -1 or more)"));
 
   // Data sources: (file, offset) pairs; attached data lives after the header.
   std::vector<std::string> files;

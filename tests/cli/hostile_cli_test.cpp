@@ -71,5 +71,94 @@ TEST(Hostile, LabelNamesMustBeABoundedRegularFile) {
   EXPECT_TRUE(fs::exists(tmp.path("out/right.ply")));
 }
 
+// A 16³ mask (a centred 8³ cube of ones) as a volume to patch.
+ScalarVolume cube_mask() {
+  ScalarVolume v;
+  v.lattice.dims = {16, 16, 16};
+  v.type = ScalarType::u8;
+  v.bytes.assign(v.lattice.size(), std::byte{0});
+  for (int64_t k = 4; k < 12; ++k)
+    for (int64_t j = 4; j < 12; ++j)
+      for (int64_t i = 4; i < 12; ++i) v.bytes[v.lattice.linear(i, j, k)] = std::byte{1};
+  return v;
+}
+
+std::string gzip(const std::string& s) {
+  const auto z = detail::deflate_buffer(reinterpret_cast<const std::byte*>(s.data()), s.size(), true);
+  return std::string(reinterpret_cast<const char*>(z.data()), z.size());
+}
+
+// `extract FILE -o out.ply` refused with exit 1, one line naming FILE and
+// holding `what`, nothing written.
+void expect_extract_refused(const test::TempDir& tmp, const std::string& file, const std::string& what) {
+  SCOPED_TRACE(file);
+  const test::CliRun r = test::run_cli_measured("-q extract " + file + " -o " + tmp.path("out.ply"), kAddressSpace);
+  expect_refused(r, file, what);
+  EXPECT_FALSE(fs::exists(tmp.path("out.ply")));
+}
+
+// NIfTI header values nifti_clib replaced silently: vox_offset 1e12 (read
+// from byte 352), qoffset_x inf (origin 0), scl_slope inf or scl_inter NaN
+// (scaling dropped); NaN srow or pixdim. Each field at its NIfTI-1 offset.
+TEST(Hostile, NiftiFieldsThatAreNotNumbersAreRefused) {
+  test::TempDir tmp;
+  write_volume(tmp.path("ok.nii"), cube_mask());
+  const std::string good = test::read_file(tmp.path("ok.nii"));
+  int32_t hdr = 0;
+  std::memcpy(&hdr, good.data(), 4);
+  ASSERT_EQ(hdr, 348);  // NIfTI-1, little-endian
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  auto patched = [&](const std::string& name, std::vector<std::pair<size_t, float>> fields, bool gz = false) {
+    std::string b = good;
+    for (const auto& [at, x] : fields) std::memcpy(b.data() + at, &x, 4);
+    const std::string path = tmp.path(name);
+    test::write_file(path, gz ? gzip(b) : b);
+    return path;
+  };
+  expect_extract_refused(tmp, patched("offset.nii", {{108, 1e12f}}), "vox_offset");
+  expect_extract_refused(tmp, patched("qoffset.nii", {{268, inf}}), "qoffset_x");
+  expect_extract_refused(tmp, patched("srow.nii", {{292, nan}}), "srow_x[3]");
+  expect_extract_refused(tmp, patched("pixdim.nii", {{80, inf}}), "pixdim[1]");
+  expect_extract_refused(tmp, patched("slope.nii", {{112, inf}}), "scl_slope");
+  expect_extract_refused(tmp, patched("inter.nii", {{112, 2.0f}, {116, nan}}), "scl_inter");
+  expect_extract_refused(tmp, patched("slope.nii.gz", {{112, -inf}}, true), "scl_slope");
+  // nibabel's "no scaling" (NaN slope and intercept) and the standard's zero slope are read.
+  for (const std::string name : {"nibabel.nii", "zero.nii"}) {
+    const std::string path = patched(name, {{112, name[0] == 'n' ? nan : 0.0f}, {116, nan}});
+    std::string out;
+    EXPECT_EQ(test::run_cli("-q extract " + path + " -o " + tmp.path(name + ".ply"), &out), 0) << out;
+  }
+}
+
+// NRRD and MetaImage fields read as a default: byte skip -5 as 0, spacings
+// "-1 nan 0" as 1; MHA BinaryData = False said "data size does not match";
+// an MHD whose data file is missing named only the data file.
+TEST(Hostile, NrrdAndMetaImageFieldsAreNotReplacedByDefaults) {
+  test::TempDir tmp;
+  const ScalarVolume v = cube_mask();
+  const std::string data(reinterpret_cast<const char*>(v.bytes.data()), v.bytes.size());
+  auto nrrd = [&](const std::string& name, const std::string& fields) {
+    test::write_file(tmp.path(name), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 16 16 16\nencoding: raw\n" + fields +
+                                         "\n" + data);
+    return tmp.path(name);
+  };
+  expect_extract_refused(tmp, nrrd("skip.nrrd", "byte skip: -5\n"), "byte skip");
+  expect_extract_refused(tmp, nrrd("spacings.nrrd", "spacings: -1 nan 0\n"), "spacings");
+  expect_extract_refused(tmp, nrrd("inf.nrrd", "spacings: 1 inf 1\n"), "spacings");
+  // -1 (the file's last bytes) stays valid for raw data, as NRRD defines it.
+  std::string out;
+  EXPECT_EQ(test::run_cli("-q extract " + nrrd("last.nrrd", "byte skip: -1\n") + " -o " + tmp.path("last.ply"), &out), 0)
+      << out;
+  std::string ascii;
+  for (std::byte b : v.bytes) ascii += std::to_string(int(b)) + " ";
+  test::write_file(tmp.path("ascii.mha"),
+                   "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\nBinaryData = False\n"
+                   "ElementDataFile = LOCAL\n" + ascii);
+  expect_extract_refused(tmp, tmp.path("ascii.mha"), "BinaryData");
+  test::write_file(tmp.path("lost.mhd"), "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\n"
+                                         "ElementDataFile = lost.raw\n");
+  expect_extract_refused(tmp, tmp.path("lost.mhd"), "lost.raw");
+}
+
 }  // namespace
 }  // namespace voxpress
