@@ -88,31 +88,43 @@ std::vector<std::byte> read_range(const std::string& path, uint64_t offset, uint
   return buf;
 }
 
-void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected) {
+// A deflate stream expands at most 1032:1 (a 258-byte match in about two
+// bits); a payload declaring more cannot hold it and is refused before any
+// allocation or inflation (issue 73: a 24-byte gzip declaring 512 MiB).
+void check_ratio(const std::string& path, size_t in_size, uint64_t expected) {
+  const uint64_t most = (uint64_t(in_size) + 64) * kMaxDeflateRatio;
+  if (expected > most)
+    throw InputError(path, "the compressed payload has " + std::to_string(in_size) + " bytes, which can hold at most " +
+                               std::to_string(most) + " (deflate expands at most " + std::to_string(kMaxDeflateRatio) +
+                               ":1), but the header declares " + std::to_string(expected));
+}
+
+void inflate_stream(const std::string& path, const std::byte* in, size_t in_size, uint64_t expected,
+                    const std::function<void(const std::byte*, size_t)>& sink, bool more_allowed) {
   z_stream zs{};
   if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(path, "zlib initialisation failed");
   struct Guard {
     z_stream* z;
     ~Guard() { inflateEnd(z); }
   } guard{&zs};
+  std::vector<std::byte> scratch(size_t(1) << 20);
   uint64_t produced = 0;
   size_t consumed = 0;
-  const uInt kChunk = 1u << 30;
+  bool ended = false;
   for (;;) {
     zs.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(in + consumed));
-    zs.avail_in = uInt(std::min<size_t>(in_size - consumed, kChunk));
-    unsigned char probe;
-    const bool full = produced == expected;
-    zs.next_out = full ? &probe : reinterpret_cast<Bytef*>(out + produced);
-    zs.avail_out = full ? 1u : uInt(std::min<uint64_t>(expected - produced, kChunk));
-    const uInt before_in = zs.avail_in, before_out = zs.avail_out;
+    zs.avail_in = uInt(std::min<size_t>(in_size - consumed, size_t(1) << 30));
+    zs.next_out = reinterpret_cast<Bytef*>(scratch.data());
+    zs.avail_out = uInt(scratch.size());
+    const uInt before_in = zs.avail_in;
     const int rc = inflate(&zs, Z_NO_FLUSH);
     consumed += before_in - zs.avail_in;
-    const uInt wrote = before_out - zs.avail_out;
-    if (full && wrote > 0)
+    const size_t wrote = scratch.size() - zs.avail_out;
+    if (!more_allowed && wrote > expected - produced)
       throw InputError(path, "the compressed payload holds more than the " + std::to_string(expected) +
                                  " bytes the header declares (dimensions or type do not match the data)");
-    produced += full ? 0 : wrote;
+    if (wrote) sink(scratch.data(), wrote);
+    produced += wrote;
     if (rc == Z_STREAM_END) {
       // Another gzip member may follow (concatenated gzip).
       size_t skip = consumed;
@@ -122,16 +134,48 @@ void inflate_exact(const std::string& path, const std::byte* in, size_t in_size,
         inflateReset(&zs);
         continue;
       }
+      ended = true;
       break;
     }
-    if (rc == Z_BUF_ERROR && consumed == in_size) break;  // input exhausted
     if (rc != Z_OK && rc != Z_BUF_ERROR)
       throw InputError(path, std::string("corrupt compressed payload (zlib: ") + (zs.msg ? zs.msg : "error") + ")");
-    if (consumed == in_size && zs.avail_out != 0 && wrote == 0) break;
+    if (consumed == in_size && wrote == 0) break;  // input exhausted before the stream's end
   }
   if (produced < expected)
     throw InputError(path, "truncated: the compressed payload holds " + std::to_string(produced) +
                                " bytes but the header declares " + std::to_string(expected));
+  if (!ended)
+    throw InputError(path, "truncated: the compressed payload ends before its end marker and check value "
+                           "(a gzip without its CRC trailer)");
+}
+
+void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected) {
+  check_ratio(path, in_size, expected);
+  uint64_t at = 0;
+  inflate_stream(path, in, in_size, expected, [&](const std::byte* p, size_t n) {
+    std::memcpy(out + at, p, n);
+    at += n;
+  }, false);
+}
+
+std::vector<std::byte> inflate_grown(const std::string& path, const std::byte* in, size_t in_size, uint64_t expected) {
+  check_ratio(path, in_size, expected);
+  // A single gzip member ends with its length modulo 2^32. When that is not
+  // the declared size (another length, several members, padding), the stream
+  // is first inflated without keeping anything, so a payload holding more or
+  // less than declared is refused before the buffer exists (16 MiB of
+  // gzipped zeros declaring 1 GiB peaked at 1.06 GB).
+  const bool gzip = in_size >= 18 && in[0] == std::byte{0x1f} && in[1] == std::byte{0x8b};
+  uint32_t isize = 0;
+  if (gzip)
+    for (int b = 3; b >= 0; --b) isize = (isize << 8) | uint32_t(in[in_size - 4 + size_t(b)]);
+  if (!gzip || isize != uint32_t(expected)) inflate_stream(path, in, in_size, expected, [](const std::byte*, size_t) {}, false);
+  // Reserved, not filled: the pages are touched as the data arrives.
+  std::vector<std::byte> out;
+  out.reserve(expected);
+  inflate_stream(path, in, in_size, expected, [&](const std::byte* p, size_t n) { out.insert(out.end(), p, p + n); },
+                 false);
+  return out;
 }
 
 std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzip_wrapper, int level) {

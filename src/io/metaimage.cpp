@@ -176,7 +176,6 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   for (const auto& src : sources)
     if (std::error_code ec; !std::filesystem::exists(src.first, ec))
       throw InputError(path, "its data file " + src.first + " does not exist");
-  v.bytes.resize(bytes);
   if (compressed) {
     std::vector<std::byte> z;
     for (const auto& [file, off] : sources) {
@@ -190,8 +189,9 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
       const int64_t n = parse_int(path, *cs, "CompressedDataSize");
       if (n > 0 && uint64_t(n) < z.size()) z.resize(size_t(n));
     }
-    inflate_exact(path, z.data(), z.size(), v.bytes.data(), bytes);
+    v.bytes = inflate_grown(path, z.data(), z.size(), bytes);
   } else {
+    v.bytes.resize(bytes);
     if (sources.size() > 1 && bytes % sources.size()) throw InputError(path, "LIST files cannot split the data evenly");
     const uint64_t per = bytes / sources.size();
     for (size_t i = 0; i < sources.size(); ++i) {

@@ -148,6 +148,35 @@ uint64_t check_header(const std::string& path) {
   return uint64_t(offset);
 }
 
+// The samples of a gzipped single-file NIfTI, inflated by us rather than by
+// nifti_clib's gzread, which accepted a stream without its CRC trailer and
+// allocated the declared size up front: the payload must be able to hold the
+// declared data (at most 1032:1), the buffer grows as the data arrives, and
+// the stream must end with its check value (issue 73).
+std::vector<std::byte> load_gzipped(const std::string& path, const nifti_image& nim, uint64_t count, size_t vs,
+                                    uint64_t max_bytes) {
+  const uint64_t fsize = file_size(path);
+  check_limit(path, fsize, max_bytes, "the compressed file");
+  const std::vector<std::byte> z = read_range(path, 0, fsize);
+  const uint64_t offset = uint64_t(nim.iname_offset), bytes = count * vs;
+  check_ratio(path, z.size(), offset + bytes);
+  std::vector<std::byte> out;
+  out.reserve(bytes);
+  uint64_t at = 0;  // position in the inflated stream
+  inflate_stream(path, z.data(), z.size(), offset + bytes, [&](const std::byte* p, size_t n) {
+    const uint64_t lo = std::max(at, offset), hi = std::min(at + n, offset + bytes);
+    if (lo < hi) out.insert(out.end(), p + (lo - at), p + (hi - at));
+    at += n;
+  }, true);  // bytes after the samples are ignored, as for a .nii
+  if (nim.byteorder != nifti_short_order()) swap_bytes(out.data(), count, vs);
+  return out;
+}
+
+bool gzipped(const std::string& path) {
+  const auto b = read_range(path, 0, std::min<uint64_t>(file_size(path), 2));
+  return b.size() == 2 && b[0] == std::byte{0x1f} && b[1] == std::byte{0x8b};
+}
+
 }  // namespace
 
 ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
@@ -213,18 +242,24 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   } catch (const UsageError& e) {
     throw InputError(path, e.what());
   }
-  if (nifti_image_load(nim.get()) != 0 || !nim->data)
-    throw InputError(path, "truncated or corrupt NIfTI image data");
+  std::vector<std::byte> data;
+  if (single && gzipped(path)) {
+    data = load_gzipped(path, *nim, count, vs, max_bytes);
+  } else {
+    if (nifti_image_load(nim.get()) != 0 || !nim->data)
+      throw InputError(path, "truncated or corrupt NIfTI image data");
+    data.assign(static_cast<const std::byte*>(nim->data), static_cast<const std::byte*>(nim->data) + count * vs);
+    nifti_image_unload(nim.get());
+  }
   const bool scaled = nim->scl_slope != 0 && std::isfinite(nim->scl_slope) &&
                       (nim->scl_slope != 1 || nim->scl_inter != 0);
   if (!scaled) {
-    v.bytes.resize(count * vs);
-    std::memcpy(v.bytes.data(), nim->data, count * vs);
+    v.bytes = std::move(data);
     return v;
   }
   // Apply the scaling: y = slope * x + inter.
   ScalarVolume raw = v;
-  raw.bytes.assign(static_cast<const std::byte*>(nim->data), static_cast<const std::byte*>(nim->data) + count * vs);
+  raw.bytes = std::move(data);
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   nim.reset();
   v.type = vs == 8 ? ScalarType::f64 : ScalarType::f32;

@@ -375,7 +375,6 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     for (size_t f = 0; f < parts.size(); ++f)
       read_range_into(parts[f].file, parts[f].offset, v.bytes.data() + f * per_file, per_file);
   } else if (enc == "gzip" || enc == "gz") {
-    v.bytes.resize(bytes);
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
     std::vector<std::byte> compressed;
     for (const auto& file : sources) {
@@ -386,17 +385,31 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
       auto part = read_range(file, off, fsize - off);
       compressed.insert(compressed.end(), part.begin(), part.end());
     }
-    inflate_exact(path, compressed.data(), compressed.size(), v.bytes.data(), bytes);
+    v.bytes = inflate_grown(path, compressed.data(), compressed.size(), bytes);
   } else if (enc == "text" || enc == "txt" || enc == "ascii") {
-    v.bytes.resize(bytes);
-    std::string text;
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
+    std::vector<std::pair<std::string, uint64_t>> parts;  // file, offset
+    uint64_t text_bytes = 0;
     for (const auto& file : sources) {
-      const uint64_t off = data_start(file);
+      parts.push_back({file, data_start(file)});
+      text_bytes += file_size(file) - parts.back().second;
+    }
+    // Each value takes a character and a separator: a payload shorter than
+    // that cannot hold the declared values (issue 73: 100 bytes declaring 2^29
+    // values allocated 538 MB before failing). The samples are allocated only then.
+    if (count > (text_bytes + 1) / 2)
+      throw InputError(path, "truncated: the text payload has " + std::to_string(text_bytes) +
+                                 " bytes, too few for the " + std::to_string(count) +
+                                 " values the header declares (at least 2 bytes each)");
+    check_limit(path, text_bytes, max_bytes, "the text payload");
+    std::string text;
+    text.reserve(text_bytes + parts.size());
+    for (const auto& [file, off] : parts) {
       const auto part = read_range(file, off, file_size(file) - off);
       text.append(reinterpret_cast<const char*>(part.data()), part.size());
       text.push_back('\n');
     }
+    v.bytes.resize(bytes);
     parse_text(path, text, v);
     big = false;  // already native
   } else if (enc == "bzip2" || enc == "bz2" || enc == "hex") {

@@ -160,5 +160,41 @@ TEST(Hostile, NrrdAndMetaImageFieldsAreNotReplacedByDefaults) {
   expect_extract_refused(tmp, tmp.path("lost.mhd"), "lost.raw");
 }
 
+// Memory follows the file, not the declared size: a text payload too short
+// for its values, a gzip or zlib payload that cannot expand to the declared
+// size (deflate: at most 1032:1), and gzipped zeros holding more than
+// declared were each allocated (538 MB, 1.06 GB) before failing.
+TEST(Hostile, DeclaredSizesTheFileCannotHoldAreRefusedBeforeAllocating) {
+  test::TempDir tmp;
+  const std::string big = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1024 1024 512\n";
+  test::write_file(tmp.path("text.nrrd"), big + "encoding: text\n\n1 2 3\n");
+  expect_extract_refused(tmp, tmp.path("text.nrrd"), "too few");
+  test::write_file(tmp.path("gz.nrrd"), big + "encoding: gzip\n\n" + gzip(std::string(16, '\1')));
+  expect_extract_refused(tmp, tmp.path("gz.nrrd"), "1032:1");
+  const auto z = detail::deflate_buffer(reinterpret_cast<const std::byte*>("\1\1\1\1"), 4, false);
+  test::write_file(tmp.path("z.mha"), "NDims = 3\nDimSize = 1024 1024 512\nElementType = MET_UCHAR\n"
+                                      "CompressedData = True\nElementDataFile = LOCAL\n" +
+                                          std::string(reinterpret_cast<const char*>(z.data()), z.size()));
+  expect_extract_refused(tmp, tmp.path("z.mha"), "1032:1");
+  // Five gzip members of 64 MiB of zeros (320 MiB) declaring 256 MiB: the
+  // length trailer differs, so the stream is measured before the buffer exists.
+  const std::string member = gzip(std::string(size_t(64) << 20, '\0'));
+  std::string five;
+  for (int i = 0; i < 5; ++i) five += member;
+  test::write_file(tmp.path("zeros.nrrd"), big.substr(0, big.size() - 4) + "256\nencoding: gzip\n\n" + five);
+  expect_extract_refused(tmp, tmp.path("zeros.nrrd"), "more than");
+}
+
+// A gzip without its CRC trailer (the last 8 bytes) was accepted: NRRD and .nii.gz.
+TEST(Hostile, GzipWithoutItsTrailerIsTruncated) {
+  test::TempDir tmp;
+  for (const std::string name : {"cut.nrrd", "cut.nii.gz"}) {
+    write_volume(tmp.path(name), cube_mask());
+    const std::string b = test::read_file(tmp.path(name));
+    test::write_file(tmp.path(name), b.substr(0, b.size() - 8));
+    expect_extract_refused(tmp, tmp.path(name), "truncated");
+  }
+}
+
 }  // namespace
 }  // namespace voxpress
