@@ -130,7 +130,7 @@ VoxelArt read_vxl(const std::string& path, const VoxelArtReadOptions& options) {
       throw InputError(path, where + ": transform or bounds are not finite");
     const uint64_t cells = uint64_t(g.dims[0]) * uint64_t(g.dims[1]) * uint64_t(g.dims[2]);
     total_cells += cells;
-    check_limit(path, total_cells * sizeof(Rgba), cap, "the voxel grids");
+    check_limit(path, total_cells * kVoxartBytesPerCell, cap, "the voxel grids (" + std::to_string(kVoxartBytesPerCell) + " bytes per cell)");
     g.voxels.assign(cells, Rgba{0, 0, 0, 0});
     ByteCursor starts(path, data, body + start_off, body + start_off + columns * 4);
     ByteCursor ends(path, data, body + end_off, body + end_off + columns * 4);

@@ -196,5 +196,43 @@ TEST(Hostile, GzipWithoutItsTrailerIsTruncated) {
   }
 }
 
+// A .vox whose group lists its child twice, 40 deep: 2^40 instances from a
+// 1 KB file (grew until the machine ran out of memory).
+TEST(Hostile, VoxSceneGraphsAreCountedBeforeTheyAreExpanded) {
+  test::TempDir tmp;
+  auto trn = [](int id, int child, const std::string& t) {
+    return vox_chunk("nTRN", le32(id) + vox_dict({}) + le32(child) + le32(-1) + le32(0) + le32(1) +
+                                 vox_dict(t.empty() ? std::vector<std::pair<std::string, std::string>>{}
+                                                    : std::vector<std::pair<std::string, std::string>>{{"_t", t}}));
+  };
+  auto shp = [](int id) { return vox_chunk("nSHP", le32(id) + vox_dict({}) + le32(1) + le32(0) + vox_dict({})); };
+  std::string dag = trn(0, 1, "");
+  for (int i = 1; i <= 40; ++i) dag += vox_chunk("nGRP", le32(i) + vox_dict({}) + le32(2) + le32(i + 1) + le32(i + 1));
+  dag += shp(41);
+  const std::string model = test::vox_model({1, 1, 1}, {{0, 0, 0, 1}});
+  test::write_file(tmp.path("dag40.vox"), test::vox_file(model + dag));
+  test::CliRun r = test::run_cli_measured("--max-memory 100M voxart " + tmp.path("dag40.vox") + " -o " +
+                                              tmp.path("d.glb"), kAddressSpace);
+  expect_refused(r, tmp.path("dag40.vox"), "1099511627776 shape instances");
+  EXPECT_FALSE(fs::exists(tmp.path("d.glb")));
+  // Two 4³ instances 32 million voxels apart: a 3.3 GB grid (4 bytes a cell)
+  // that --max-memory 3G accepted before dying at 4.2 GB.
+  std::vector<std::array<uint8_t, 4>> voxels;
+  for (uint8_t i = 0; i < 4; ++i) voxels.push_back({i, i, i, 1});
+  const std::string far = trn(0, 1, "") + vox_chunk("nGRP", le32(1) + vox_dict({}) + le32(2) + le32(2) + le32(4)) +
+                          trn(2, 3, "16000000 0 0") + shp(3) + trn(4, 5, "-16000000 0 0") + shp(5);
+  test::write_file(tmp.path("far.vox"), test::vox_file(test::vox_model({4, 4, 4}, voxels) + far));
+  r = test::run_cli_measured("--max-memory 3G voxart " + tmp.path("far.vox") + " -o " + tmp.path("f.glb"), kAddressSpace);
+  expect_refused(r, tmp.path("far.vox"), "32000004 x 4 x 4 cells");
+  EXPECT_FALSE(fs::exists(tmp.path("f.glb")));
+  // The same scene 16 voxels apart is converted.
+  const std::string near = trn(0, 1, "") + vox_chunk("nGRP", le32(1) + vox_dict({}) + le32(2) + le32(2) + le32(4)) +
+                           trn(2, 3, "8 0 0") + shp(3) + trn(4, 5, "-8 0 0") + shp(5);
+  test::write_file(tmp.path("near.vox"), test::vox_file(test::vox_model({4, 4, 4}, voxels) + near));
+  r = test::run_cli_measured("-q voxart " + tmp.path("near.vox") + " -o " + tmp.path("n.glb"), kAddressSpace);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(tmp.path("n.glb")));
+}
+
 }  // namespace
 }  // namespace voxpress
