@@ -234,5 +234,35 @@ TEST(Hostile, VoxSceneGraphsAreCountedBeforeTheyAreExpanded) {
   EXPECT_TRUE(fs::exists(tmp.path("n.glb")));
 }
 
+// float32 room judged per axis: a 16³ sphere with spacing (0.01, 1, 100) at
+// the origin was refused ("coordinates too large for its spacing"); one 1e5
+// from the origin at spacing 0.5 still is.
+TEST(Hostile, Float32RoomIsJudgedPerAxis) {
+  test::TempDir tmp;
+  ScalarVolume v;
+  v.lattice.dims = {16, 16, 16};
+  v.type = ScalarType::u8;
+  v.bytes.assign(v.lattice.size(), std::byte{0});
+  for (int64_t k = 0; k < 16; ++k)
+    for (int64_t j = 0; j < 16; ++j)
+      for (int64_t i = 0; i < 16; ++i) {
+        const double x = i - 7.5, y = j - 7.5, z = k - 7.5;
+        if (x * x + y * y + z * z < 36) v.bytes[v.lattice.linear(i, j, k)] = std::byte{1};
+      }
+  v.lattice.spacing = Vec3(0.01, 1, 100);
+  write_volume(tmp.path("aniso.nrrd"), v);
+  std::string out;
+  ASSERT_EQ(test::run_cli("-q press " + tmp.path("aniso.nrrd") + " -o " + tmp.path("aniso.stl") + " --check", &out), 0)
+      << out;
+  EXPECT_EQ(test::run_cli("check " + tmp.path("aniso.stl") + " --volume " + tmp.path("aniso.nrrd"), &out), 0) << out;
+  EXPECT_NE(out.find("0 violations"), std::string::npos) << out;
+  v.lattice.spacing = Vec3(0.5, 0.5, 0.5);
+  v.lattice.origin = Vec3(1e5, 0, 0);
+  write_volume(tmp.path("far.nrrd"), v);
+  const test::CliRun r = test::run_cli_measured("-q press " + tmp.path("far.nrrd") + " -o " + tmp.path("far.ply"));
+  expect_refused(r, tmp.path("far.nrrd"), "float32");
+  EXPECT_FALSE(fs::exists(tmp.path("far.ply")));
+}
+
 }  // namespace
 }  // namespace voxpress
