@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 
 namespace voxpress::detail {
 
@@ -210,10 +211,17 @@ void swap_bytes(std::byte* data, uint64_t count, size_t width) {
   for (uint64_t i = 0; i < count; ++i) std::reverse(data + i * width, data + (i + 1) * width);
 }
 
+std::string format_bytes(uint64_t bytes) {
+  // "--max-memory 1K" said "needs 0 MiB, above the limit of 0 MiB" (issue 73).
+  if (bytes >= (uint64_t(1) << 20)) return std::to_string(bytes >> 20) + " MiB";
+  if (bytes >= 1024) return std::to_string(bytes >> 10) + " KiB";
+  return std::to_string(bytes) + " bytes";
+}
+
 void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what) {
   if (cap && bytes > cap)
-    throw LimitError(path, what + " needs " + std::to_string(bytes >> 20) + " MiB, above the memory limit of " +
-                               std::to_string(cap >> 20) + " MiB (raise it with --max-memory)");
+    throw LimitError(path, what + " needs " + format_bytes(bytes) + ", above the memory limit of " + format_bytes(cap) +
+                               " (raise it with --max-memory)");
 }
 
 uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
@@ -297,7 +305,41 @@ void remove_stale_temporaries(const fs::path& dir, const std::string& prefix) {
 namespace {
 // The open OutputGroup's pending (temporary, name) pairs; null when none is open.
 thread_local std::vector<std::pair<fs::path, fs::path>>* g_pending = nullptr;
+
+// The temporaries that exist now, in fixed storage a signal handler may read
+// (SIGINT / SIGTERM during a write left the hidden .tmpPID file, issue 73).
+constexpr size_t kTemporarySlots = 512, kTemporaryPath = 4096;
+char g_temporaries[kTemporarySlots][kTemporaryPath];
+std::atomic<bool> g_temporary_used[kTemporarySlots];
+std::mutex g_temporary_mutex;
+
+void track_temporary(const fs::path& tmp) {
+  const std::string p = tmp.string();
+  if (p.size() >= kTemporaryPath) return;  // not cleaned on a signal; the next run removes it
+  std::lock_guard lock(g_temporary_mutex);
+  for (size_t i = 0; i < kTemporarySlots; ++i)
+    if (!g_temporary_used[i].load()) {
+      std::memcpy(g_temporaries[i], p.c_str(), p.size() + 1);
+      g_temporary_used[i].store(true);
+      return;
+    }
+}
+
+void untrack_temporary(const fs::path& tmp) {
+  const std::string p = tmp.string();
+  std::lock_guard lock(g_temporary_mutex);
+  for (size_t i = 0; i < kTemporarySlots; ++i)
+    if (g_temporary_used[i].load() && p == g_temporaries[i]) {
+      g_temporary_used[i].store(false);
+      return;
+    }
+}
 }  // namespace
+
+void remove_temporaries_on_signal() noexcept {
+  for (size_t i = 0; i < kTemporarySlots; ++i)
+    if (g_temporary_used[i].load()) ::unlink(g_temporaries[i]);  // async-signal-safe
+}
 
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
   static std::atomic<unsigned> counter{0};
@@ -313,6 +355,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
   name.append("-").append(std::to_string(counter++)).append(ext);
   const fs::path tmp = dir / name;
   remove_stale_temporaries(dir, std::string(".").append(target.filename().string()).append(".tmp"));
+  track_temporary(tmp);
   try {
     write(tmp.string());
     if (g_pending) {
@@ -320,6 +363,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
       for (auto& [t, final_name] : *g_pending)
         if (final_name == target) {
           fs::remove(t, ec);
+          untrack_temporary(t);
           t = tmp;
           return;
         }
@@ -328,8 +372,10 @@ void write_atomically(const std::string& path, const std::function<void(const st
     }
     fs::rename(tmp, target, ec);
     if (ec) throw InputError(path, "cannot write: " + ec.message());
+    untrack_temporary(tmp);
   } catch (...) {
     fs::remove(tmp, ec);
+    untrack_temporary(tmp);
     throw;
   }
 }
@@ -361,7 +407,10 @@ OutputGroup::OutputGroup() {
 OutputGroup::~OutputGroup() {
   if (!detail::g_pending) return;
   std::error_code ec;
-  for (const auto& [tmp, name] : *detail::g_pending) fs::remove(tmp, ec);
+  for (const auto& [tmp, name] : *detail::g_pending) {
+    fs::remove(tmp, ec);
+    detail::untrack_temporary(tmp);
+  }
   delete detail::g_pending;
   detail::g_pending = nullptr;
 }
@@ -372,6 +421,7 @@ void OutputGroup::commit_open() {
   for (size_t i = 0; i < pending->size(); ++i) {
     std::error_code ec;
     fs::rename((*pending)[i].first, (*pending)[i].second, ec);
+    if (!ec) detail::untrack_temporary((*pending)[i].first);
     if (ec) {
       pending->erase(pending->begin(), pending->begin() + std::ptrdiff_t(i));
       throw InputError((*pending)[0].second.string(), "cannot write: " + ec.message());
@@ -381,4 +431,21 @@ void OutputGroup::commit_open() {
 }
 
 void OutputGroup::commit() { commit_open(); }
+
+namespace {
+extern "C" void remove_temporaries_and_die(int sig) {
+  detail::remove_temporaries_on_signal();
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+}  // namespace
+
+void remove_temporaries_on_signals() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction sa {};
+    sa.sa_handler = remove_temporaries_and_die;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
 }  // namespace voxpress

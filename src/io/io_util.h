@@ -71,6 +71,8 @@ void swap_bytes(std::byte* data, uint64_t count, size_t width);
 /// must be before it is converted to an integer (NaN never is).
 inline bool whole_in(double x, double lo, double hi) { return x >= lo && x <= hi && x == std::floor(x); }
 
+/// A size for a message: "12 MiB", "3 KiB" or "100 bytes".
+std::string format_bytes(uint64_t bytes);
 /// Throws LimitError(path, ...) if `bytes` exceeds the cap (0 = no cap).
 void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);
 /// dims product with overflow check; throws InputError on absurd dimensions.
@@ -87,6 +89,8 @@ std::string format_typed(ScalarType t, double x);
 double parse_double(const std::string& path, const std::string& text, const std::string& what);
 int64_t parse_int(const std::string& path, const std::string& text, const std::string& what);
 
+/// Unlinks every temporary of a write in progress; async-signal-safe.
+void remove_temporaries_on_signal() noexcept;
 /// Writes a file atomically: `write` receives the path of a temporary file in
 /// the destination folder (same extension, so format-sniffing libraries see
 /// the right suffix); on success it is renamed over `path`, on any exception

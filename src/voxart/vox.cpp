@@ -205,8 +205,8 @@ void check_scene(const std::string& path, const Reach& reach, uint64_t cap) {
   if (cap && reach.instances > cap / per_instance)
     throw LimitError(path, "the scene graph places " +
                                (reach.instances == UINT64_MAX ? std::string("more than 2^64") : std::to_string(reach.instances)) +
-                               " shape instances, above what the memory limit of " + std::to_string(cap >> 20) +
-                               " MiB holds (raise it with --max-memory)");
+                               " shape instances, above what the memory limit of " + format_bytes(cap) +
+                               " holds (raise it with --max-memory)");
   std::array<int64_t, 3> dims{};
   for (size_t a = 0; a < 3; ++a) dims[a] = reach.hi[a] - reach.lo[a] + 1;
   const uint64_t cells = checked_count(path, dims, 1, kVoxartBytesPerCell);

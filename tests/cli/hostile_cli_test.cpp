@@ -264,5 +264,60 @@ TEST(Hostile, Float32RoomIsJudgedPerAxis) {
   EXPECT_FALSE(fs::exists(tmp.path("far.ply")));
 }
 
+// Issue 73, item 6: the smaller defects, each a case below.
+TEST(Hostile, SmallerDefectsGetTheRightCodeAndOneLineNamingTheFile) {
+  test::TempDir tmp;
+  write_volume(tmp.path("cube.nrrd"), cube_mask());
+  const std::string cube = tmp.path("cube.nrrd");
+  auto run = [&](const std::string& args) {
+    const test::CliRun r = test::run_cli_measured("-q " + args, kAddressSpace);
+    EXPECT_EQ(count_lines(r.output), 1u) << args << ": " << r.output;
+    return r;
+  };
+  // Usage errors, exit 2, before any output: voxart texture sizes (--max-texture
+  // -5 was exit 1, --texels-per-voxel 0 and -1 accepted), -o "" (failed after
+  // the whole press), --raw-header-bytes -1 (wrapped to 2^64-1).
+  test::write_file(tmp.path("m.vox"), test::vox_file(test::vox_model({2, 2, 2}, {{0, 0, 0, 1}, {1, 1, 1, 2}})));
+  for (const std::string opt : {"--max-texture -5", "--max-texture 0", "--texels-per-voxel 0", "--texels-per-voxel -1"}) {
+    const test::CliRun r = run("voxart " + tmp.path("m.vox") + " -o " + tmp.path("m.glb") + " " + opt);
+    EXPECT_EQ(r.code, 2) << opt << ": " << r.output;
+    EXPECT_NE(r.output.find(opt.substr(0, opt.find(' '))), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(tmp.path("m.glb")));
+  std::string said;  // through the shell, which passes '' as an empty argument
+  EXPECT_EQ(test::run_cli("-q press " + cube + " -o ''", &said), 2) << said;
+  EXPECT_NE(said.find("empty"), std::string::npos) << said;
+  EXPECT_EQ(count_lines(said), 1u) << said;
+  test::CliRun r;
+  test::write_file(tmp.path("v.raw"), std::string(4096, '\1'));
+  r = run("extract " + tmp.path("v.raw") + " --raw-dims 16,16,16 --raw-header-bytes -1 -o " + tmp.path("r.ply"));
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--raw-header-bytes"), std::string::npos) << r.output;
+  // --max-memory 1K said "needs 0 MiB, above the memory limit of 0 MiB".
+  r = run("--max-memory 1K extract " + cube + " -o " + tmp.path("c.ply"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(r.output.find("0 MiB"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 KiB"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path("c.ply")));
+  // An error quoting a whole broken glTF buffer (161 KB) is cut to a line of
+  // bounded length that still names the file.
+  test::write_file(tmp.path("b.gltf"), R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":4,"uri":"data:application/x-broken;base64,)" +
+                                           std::string(200000, 'A') + R"("}]})");
+  r = run("check " + tmp.path("b.gltf"));
+  EXPECT_EQ(r.code, 1) << r.output.substr(0, 300);
+  EXPECT_NE(r.output.find(tmp.path("b.gltf")), std::string::npos) << r.output.substr(0, 300);
+  EXPECT_LT(r.output.size(), 1000u);
+  // A NaN in the .hva: named (it was "a texture chart would exceed 10^9 texels").
+  test::write_file(tmp.path("u.vxl"), test::vxl_file());
+  std::string hva = std::string("u") + std::string(15, '\0') + le32(1) + le32(1) + std::string("Body") + std::string(12, '\0');
+  for (float v : {1.f, 0.f, 0.f, std::numeric_limits<float>::quiet_NaN(), 0.f, 1.f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f})
+    hva += test::f32(v);
+  test::write_file(tmp.path("u.hva"), hva);
+  r = run("voxart " + tmp.path("u.vxl") + " -o " + tmp.path("u.glb"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find(tmp.path("u.hva")), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path("u.glb")));
+}
+
 }  // namespace
 }  // namespace voxpress
