@@ -34,6 +34,11 @@ std::string file_stem(const std::string& name) {
   std::string out;
   for (unsigned char ch : name) out += (std::isalnum(ch) || ch == '-' || ch == '_' || ch == '.') ? char(ch) : '_';
   while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  // At most 120 characters: with "label_N_" and the extension the name stays
+  // under the 255 bytes of a file name (a 5,000-character name failed with
+  // "File name too long" after the folder was made, issue 73). Two names cut
+  // to the same stem fall back to label_N_<stem>, which the value keeps apart.
+  if (out.size() > 120) out.resize(120);
   return out;
 }
 

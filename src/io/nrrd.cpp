@@ -282,6 +282,8 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     };
     s.name = get("_Name") ? *get("_Name") : value;
     if (const auto* lv = get("_LabelValue")) s.label = parse_double(path, *lv, prefix + "_LabelValue");
+    // A NaN label matches no sample: the segment was dropped from --labels all (issue 73).
+    if (!std::isfinite(s.label)) throw InputError(path, prefix + "_LabelValue is " + format_double(s.label) + ", not a label");
     if (const auto* ly = get("_Layer")) s.layer = parse_int(path, *ly, prefix + "_Layer");
     v.segments.push_back(s);
   }

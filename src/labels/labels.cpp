@@ -250,7 +250,10 @@ std::vector<LabelInfo> select_labels(const LabelTable& table, const std::vector<
       for (size_t i = 0; i < table.labels.size() && i < 20; ++i)
         have += (i ? ", " : "") + format_value(table.labels[i].value);
       if (table.labels.size() > 20) have += ", ...";
-      throw InputError(source, "no sample has label " + format_value(value) + " (labels: " + have + ")");
+      // 0 is never a label (issue 73: "no sample has label 0" on a map full of zeros).
+      throw InputError(source, (value == 0 ? std::string("0 is the background, not a label")
+                                           : "no sample has label " + format_value(value)) +
+                                   " (labels: " + have + ")");
     }
   }
   return out;

@@ -319,5 +319,45 @@ TEST(Hostile, SmallerDefectsGetTheRightCodeAndOneLineNamingTheFile) {
   EXPECT_FALSE(fs::exists(tmp.path("u.glb")));
 }
 
+// Label maps: a 5,000-character name (failed with "File name too long" after
+// making the folder), two segments of one name (--segment picked one), a
+// segment labelled NaN (dropped from --labels all), --labels 0 ("no sample
+// has label 0" on a map full of zeros).
+TEST(Hostile, LabelNamesAndSegmentsThatWereMisread) {
+  test::TempDir tmp;
+  write_label_map(tmp.path("map.nrrd"));
+  test::write_file(tmp.path("long.txt"), "7 " + std::string(5000, 'x') + "\n300 right\n");
+  std::string out;
+  ASSERT_EQ(test::run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --label-names " + tmp.path("long.txt") +
+                              " -o " + tmp.path("long"),
+                          &out),
+            0)
+      << out.substr(0, 300);
+  EXPECT_TRUE(fs::exists(tmp.path("long/" + std::string(120, 'x') + ".ply")));
+  test::CliRun r = test::run_cli_measured("-q press " + tmp.path("map.nrrd") + " --labels 0 -o " + tmp.path("zero"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("background"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path("zero")));
+  const ScalarVolume v = cube_mask();
+  const std::string data(reinterpret_cast<const char*>(v.bytes.data()), v.bytes.size());
+  auto seg = [&](const std::string& name, const std::string& second) {
+    test::write_file(tmp.path(name), "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 16 16 16\nencoding: raw\n"
+                                     "Segment0_ID:=Segment_1\nSegment0_Name:=liver\nSegment0_LabelValue:=1\nSegment0_Layer:=0\n" +
+                                         second + "\n" + data);
+    return tmp.path(name);
+  };
+  const std::string twice = seg("twice.seg.nrrd", "Segment1_ID:=Segment_2\nSegment1_Name:=liver\nSegment1_LabelValue:=2\nSegment1_Layer:=0\n");
+  r = test::run_cli_measured("-q extract " + twice + " --segment liver -o " + tmp.path("t.ply"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("Segment_2"), std::string::npos) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1u) << r.output;
+  EXPECT_FALSE(fs::exists(tmp.path("t.ply")));
+  ASSERT_EQ(test::run_cli("-q extract " + twice + " --segment Segment_1 -o " + tmp.path("t.ply"), &out), 0) << out;
+  const std::string nan = seg("nan.seg.nrrd", "Segment1_ID:=Segment_2\nSegment1_Name:=spleen\nSegment1_LabelValue:=nan\nSegment1_Layer:=0\n");
+  expect_refused(test::run_cli_measured("-q press " + nan + " --labels all -o " + tmp.path("nan"), kAddressSpace), nan,
+                 "Segment1_LabelValue");
+  EXPECT_FALSE(fs::exists(tmp.path("nan")));
+}
+
 }  // namespace
 }  // namespace voxpress
