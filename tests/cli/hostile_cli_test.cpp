@@ -359,5 +359,22 @@ TEST(Hostile, LabelNamesAndSegmentsThatWereMisread) {
   EXPECT_FALSE(fs::exists(tmp.path("nan")));
 }
 
+// eval --truth accepted an open mesh (volume ratio 24.9, no warning) that
+// voxelize refuses: a truth is a solid, or the run is refused naming it.
+TEST(Hostile, EvalRefusesAnOpenTruthMesh) {
+  test::TempDir tmp;
+  write_volume(tmp.path("cube.nrrd"), cube_mask());
+  std::string out;
+  ASSERT_EQ(test::run_cli("-q extract " + tmp.path("cube.nrrd") + " -o " + tmp.path("c.ply"), &out), 0) << out;
+  const std::string tetra = "v 0 0 0\nv 20 0 0\nv 0 20 0\nv 0 0 20\nf 1 3 2\nf 1 2 4\nf 1 4 3\n";
+  test::write_file(tmp.path("open.obj"), tetra);  // its fourth face missing
+  const test::CliRun r = test::run_cli_measured("eval " + tmp.path("c.ply") + " --truth " + tmp.path("open.obj") +
+                                                " --json " + tmp.path("e.json"));
+  expect_refused(r, tmp.path("open.obj"), "not closed");
+  EXPECT_FALSE(fs::exists(tmp.path("e.json")));
+  test::write_file(tmp.path("closed.obj"), tetra + "f 2 3 4\n");
+  EXPECT_EQ(test::run_cli("eval " + tmp.path("c.ply") + " --truth " + tmp.path("closed.obj"), &out), 0) << out;
+}
+
 }  // namespace
 }  // namespace voxpress
