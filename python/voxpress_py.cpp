@@ -150,11 +150,26 @@ py::array_t<int32_t> int_rows(const std::vector<std::array<uint32_t, 3>>& rows) 
   return a;
 }
 
+// A keyword's value as T, or the library's UsageError naming it: nan, 10**30
+// or a string raised pybind11's bare cast RuntimeError (issue 73).
+template <class T>
+T option(const std::string& k, const py::handle& value) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw UsageError(k + "= must be " +
+                     (std::is_same_v<T, int> ? "a whole number from 0 to 2147483647"
+                      : std::is_same_v<T, bool> ? "True or False"
+                                                : "a number") +
+                     ", not " + std::string(py::repr(value)));
+  }
+}
+
 void set_options(SurfaceOptions& o, const py::kwargs& kw) {
   for (const auto& [key, value] : kw) {
     const std::string k = py::str(key);
-    if (k == "iterations") o.overrides.iterations = value.cast<int>();
-    else if (k == "tolerance") o.overrides.tolerance = value.cast<double>();
+    if (k == "iterations") o.overrides.iterations = option<int>(k, value);
+    else if (k == "tolerance") o.overrides.tolerance = option<double>(k, value);
     else if (k == "flats") {
       if (!value.cast<bool>()) o.passes.disable(Pass::flats);
     } else if (k == "sharpen") {
@@ -162,13 +177,13 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
     } else if (k == "disable_passes") {
       for (const auto& name : value.cast<std::vector<std::string>>()) o.passes.disable(name);
     }
-    else if (k == "min_flat_area") o.flat.min_area = value.cast<double>();
-    else if (k == "junction_angle") o.flat.junction_angle = value.cast<double>();
-    else if (k == "sharp_angle") o.sharp.sharp_angle = value.cast<double>();
-    else if (k == "color_regions") o.color_regions = value.cast<bool>();
-    else if (k == "fit_rings") o.fit.rings = value.cast<int>();
-    else if (k == "lambda_") o.overrides.lambda = value.cast<double>();
-    else if (k == "mu") o.overrides.mu = value.cast<double>();
+    else if (k == "min_flat_area") o.flat.min_area = option<double>(k, value);
+    else if (k == "junction_angle") o.flat.junction_angle = option<double>(k, value);
+    else if (k == "sharp_angle") o.sharp.sharp_angle = option<double>(k, value);
+    else if (k == "color_regions") o.color_regions = option<bool>(k, value);
+    else if (k == "fit_rings") o.fit.rings = option<int>(k, value);
+    else if (k == "lambda_") o.overrides.lambda = option<double>(k, value);
+    else if (k == "mu") o.overrides.mu = option<double>(k, value);
     else
       throw py::type_error("press() got an unknown option '" + k +
                            "' (iterations, tolerance, flats, sharpen, min_flat_area, junction_angle, sharp_angle, "
@@ -291,8 +306,13 @@ void check_shared_options(const py::kwargs& kw) {
 
 std::vector<double> label_values(const py::object& labels) {
   std::vector<double> values;  // empty: every label
+  // "all" as on the command line; any other string was a bare cast error (issue 73).
+  if (py::isinstance<py::str>(labels)) {
+    if (labels.cast<std::string>() == "all") return values;
+    throw UsageError("labels= must be 'all' or a sequence of label values, not " + std::string(py::repr(labels)));
+  }
   if (!labels.is_none()) {
-    for (const py::handle& h : labels) values.push_back(h.cast<double>());
+    for (const py::handle& h : labels) values.push_back(option<double>("labels", h));
     if (values.empty()) throw UsageError("labels= selects no label");
   }
   return values;

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <sstream>
+#include <sys/resource.h>
 #include <sys/wait.h>
 
 namespace voxpress::test {
@@ -313,6 +315,42 @@ int run_cli(const std::string& args, std::string* output) {
   const int status = ::pclose(p);
   if (output) *output = out;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+CliRun run_cli_measured(const std::string& args, uint64_t address_space_limit) {
+  std::vector<std::string> words = {VOXPRESS_CLI};
+  std::istringstream fields(args);
+  for (std::string w; fields >> w;) words.push_back(w);
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  int fds[2];
+  CliRun r;
+  if (::pipe(fds) != 0) return r;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::dup2(fds[1], 1);
+    ::dup2(fds[1], 2);
+    ::close(fds[0]);
+    ::close(fds[1]);
+    if (address_space_limit) {
+      const rlimit lim{address_space_limit, address_space_limit};
+      ::setrlimit(RLIMIT_AS, &lim);
+    }
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  ::close(fds[1]);
+  char buf[4096];
+  ssize_t n;
+  while ((n = ::read(fds[0], buf, sizeof buf)) > 0) r.output.append(buf, size_t(n));
+  ::close(fds[0]);
+  int status = 0;
+  rusage usage{};
+  if (pid < 0 || ::wait4(pid, &status, 0, &usage) != pid) return r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.peak_kib = usage.ru_maxrss;
+  return r;
 }
 
 }  // namespace voxpress::test

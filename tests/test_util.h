@@ -134,6 +134,18 @@ std::string vxl_file();
 /// Runs the voxpress CLI with `args`; returns the exit code, fills output
 /// with stdout and stderr combined.
 int run_cli(const std::string& args, std::string* output = nullptr);
+/// A CLI run measured by the kernel: exit code (-1 if killed by a signal),
+/// stdout and stderr combined, and the peak resident memory of the process
+/// (wait4's ru_maxrss, KiB).
+struct CliRun {
+  int code = -1;
+  std::string output;
+  int64_t peak_kib = 0;
+};
+/// Runs the voxpress CLI with `args` (split on blanks) under an address-space
+/// limit (RLIMIT_AS, bytes; 0 = none), so that a regression fails the test
+/// instead of exhausting the machine.
+CliRun run_cli_measured(const std::string& args, uint64_t address_space_limit = 0);
 /// Lines in a command's output (one error = one line).
 inline size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 

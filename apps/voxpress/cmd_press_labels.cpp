@@ -34,6 +34,11 @@ std::string file_stem(const std::string& name) {
   std::string out;
   for (unsigned char ch : name) out += (std::isalnum(ch) || ch == '-' || ch == '_' || ch == '.') ? char(ch) : '_';
   while (!out.empty() && out.front() == '.') out.erase(out.begin());
+  // At most 120 characters: with "label_N_" and the extension the name stays
+  // under the 255 bytes of a file name (a 5,000-character name failed with
+  // "File name too long" after the folder was made, issue 73). Two names cut
+  // to the same stem fall back to label_N_<stem>, which the value keeps apart.
+  if (out.size() > 120) out.resize(120);
   return out;
 }
 
@@ -186,11 +191,12 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   if (o.chunks && options.method != Method::pressing) throw UsageError("--chunk with --labels runs --method pressing only");
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
+  // The names first: a bad table is refused before the volume is read.
+  const auto names = o.names_file.empty() ? std::map<double, std::string>{} : read_label_names(o.names_file);
   LabelSource src = open_labels(input, in, o, g, bar.get());
   if (src.volume) src.masks = masks_in(*src.volume);
   LabelTable& table = src.table;
   if (!o.names_file.empty()) {
-    const auto names = read_label_names(o.names_file);
     for (LabelInfo& l : table.labels)
       if (auto it = names.find(l.value); it != names.end()) l.name = it->second;
   }

@@ -12,12 +12,14 @@ struct VoxartCmd {
   std::string input, output, stats_json, fairing = "lanczos", packer = "best";
   VoxartOptions options;
   int64_t model = -1, frame = 0;
-  bool no_texture = false, z_up = false, ascii = false;
+  bool no_texture = false, z_up = false, ascii = false, texels_given = false;
 };
 
 void run_voxart(VoxartCmd c, const Global& g) {
   check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.stats_json, OutputKind::json}});
 
+  // 0 is the library's "automatic"; asked for on the command line it is a mistake.
+  if (c.texels_given && c.options.texels_per_voxel < 1) throw UsageError("--texels-per-voxel must be from 1 to 64");
   c.options.fairing = parse_voxart_fairing(c.fairing);
   c.options.packer = parse_atlas_packer(c.packer);
   c.options.texture = !c.no_texture;
@@ -110,7 +112,8 @@ void register_voxart(CLI::App& app, Global& g) {
   cmd->add_flag("--z-up", c->z_up, "Keep the voxel file's Z-up frame (default: Y-up, as glTF expects)");
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_option("--stats-json", c->stats_json, "Write counts, atlas figures, colour fidelity and step times as JSON");
-  cmd->callback([c, &g] {
+  cmd->callback([c, cmd, &g] {
+    c->texels_given = cmd->count("--texels-per-voxel") > 0;
     g.apply();
     run_voxart(*c, g);
   });

@@ -79,7 +79,8 @@ ReadOptions InputOptions::read_options(const Global& g) const {
     if (!raw_spacing.empty()) layout.spacing = parse_vec3(raw_spacing, "--raw-spacing");
     if (!raw_origin.empty()) layout.origin = parse_vec3(raw_origin, "--raw-origin");
     layout.big_endian = raw_big_endian;
-    layout.header_bytes = raw_header_bytes;
+    if (raw_header_bytes < 0) throw UsageError("--raw-header-bytes must be 0 or more");
+    layout.header_bytes = uint64_t(raw_header_bytes);
     r.raw = layout;
   }
   return r;
@@ -299,6 +300,10 @@ void check_paths(const std::vector<std::string>& inputs,
       if (same_file(all[i], all[j]))
         throw UsageError(all[j] + ": names the same file as " + all[i] + " (each input and output needs its own)");
   for (const auto& [path, kind] : outputs) {
+    // -o "" failed after the whole press with "unknown mesh format ''" (issue
+    // 73); the other kinds are optional outputs, empty when not asked for.
+    if (path.empty() && kind != OutputKind::json && kind != OutputKind::features)
+      throw UsageError("-o: the output file name is empty");
     if (path.empty()) continue;
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw UsageError(path + ": is a folder; give a file name for the output");

@@ -50,7 +50,7 @@ struct InputOptions {
   std::string segment;
   std::string raw_dims, raw_type = "uint8", raw_spacing, raw_origin;
   bool raw_big_endian = false;
-  uint64_t raw_header_bytes = 0;
+  int64_t raw_header_bytes = 0;  // signed: -1 wrapped to 2^64-1 (issue 73)
 
   /// Adds --label, --threshold, --segment and the --raw-* options to a command.
   void bind(CLI::App& cmd);

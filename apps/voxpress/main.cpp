@@ -3,10 +3,16 @@
 // exceptions become a message and an exit code:
 //   0 success   1 bad input (file missing, malformed, limit hit, check failed)
 //   2 bad usage (options)   3 internal error (a bug: please report it)
+#include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <string>
 
 #include "common.h"
+
+namespace {
+constexpr size_t kMaxErrorChars = 600;  // what one error line may quote
+}
 
 int main(int argc, char** argv) {
   using namespace voxpress;
@@ -32,6 +38,16 @@ int main(int argc, char** argv) {
   cli::register_render(app, g);
   cli::register_report(app, g);
 
+  // One line, of bounded length: a broken glTF buffer echoed its whole 161 KB
+  // data URI (issue 73). The file's name comes first and is kept.
+  auto line = [](const char* what) {
+    std::string m(what);
+    std::replace(m.begin(), m.end(), '\n', ' ');
+    if (m.size() > kMaxErrorChars)
+      m = m.substr(0, kMaxErrorChars) + "... (" + std::to_string(m.size() - kMaxErrorChars) + " more characters)";
+    return m;
+  };
+  remove_temporaries_on_signals();  // Ctrl-C while writing left the hidden temporary (issue 73)
   try {
     // Every output of the run appears together, once it has succeeded
     // (check_paths refused bad output paths before any work).
@@ -41,16 +57,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::Success& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "voxpress: error: %s (see voxpress --help)\n", e.what());
+    std::fprintf(stderr, "voxpress: error: %s (see voxpress --help)\n", line(e.what()).c_str());
     return 2;
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "voxpress: error: %s\n", e.what());
+    std::fprintf(stderr, "voxpress: error: %s\n", line(e.what()).c_str());
     return 2;
   } catch (const InputError& e) {
-    std::fprintf(stderr, "voxpress: error: %s\n", e.what());
+    std::fprintf(stderr, "voxpress: error: %s\n", line(e.what()).c_str());
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "voxpress: internal error: %s\n", e.what());
+    std::fprintf(stderr, "voxpress: internal error: %s\n", line(e.what()).c_str());
     return 3;
   }
   return 0;

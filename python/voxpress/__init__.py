@@ -70,8 +70,8 @@ def press_labels(array, labels=None, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
                  method="pressing", axes="xyz", **options):
     """Every label of a label map at once, as `voxpress press --labels`: {label: Mesh}.
 
-    array: integer label map (0 = background); labels: None for every
-    non-zero value, or an iterable of values (an absent one raises
+    array: integer label map (0 = background); labels: None or "all" for
+    every non-zero value, or an iterable of values (an absent one raises
     InputError). By default every label is cut from one pressed shared
     surface: touching labels share their interface vertex for vertex, each
     mesh keeps its own label's samples inside and every other sample
@@ -85,7 +85,7 @@ def press_labels(array, labels=None, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.
     """
     if "disable_passes" in options and options["disable_passes"] is not None:
         options["disable_passes"] = list(options["disable_passes"])
-    return _voxpress.press_labels(array, labels=None if labels is None else list(labels), spacing=spacing,
+    return _voxpress.press_labels(array, labels=labels if labels is None or isinstance(labels, str) else list(labels), spacing=spacing,
                                   origin=origin, direction=direction, method=method, axes=axes,
                                   **{k: v for k, v in options.items() if v is not None})
 

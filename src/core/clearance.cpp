@@ -28,6 +28,20 @@ double float32_clearance(const Lattice& lattice, double reach) {
   return std::max(4 * rounding, 1e-12);
 }
 
+double float32_rounding(const Lattice& lattice, double reach) {
+  constexpr double kHalfUlp = 0x1p-24;
+  const Mat3 M = lattice.index_to_physical_matrix();
+  Vec3 largest = Vec3::Zero();  // per physical axis, over the box's corners (the coordinates are affine)
+  for (int corner = 0; corner < 8; ++corner) {
+    Vec3 ijk;
+    for (int a = 0; a < 3; ++a)
+      ijk[a] = (corner >> a) & 1 ? double(lattice.dims[size_t(a)] - 1) + reach : -reach;
+    largest = largest.cwiseMax((lattice.origin + M * ijk).cwiseAbs());
+  }
+  const Vec3 per_axis = M.inverse().cwiseAbs() * (kHalfUlp * largest);  // index cells on each axis
+  return std::max(per_axis.norm(), 1e-12);
+}
+
 double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);

@@ -26,6 +26,15 @@ namespace voxpress::detail {
 /// two sides of a distance each move by the rounding, and a factor 2 spare.
 double float32_clearance(const Lattice& lattice, double reach = 2);
 
+/// Index-space cells: the largest move float32 rounding of the physical
+/// positions can cause for points of `lattice` within `reach` cells of its
+/// box, judged per axis: physical coordinate r rounds by at most 2^-24 times
+/// its own largest magnitude, and each index axis a receives
+/// sum_r |M^-1 (a, r)| of those. A valid anisotropic lattice (spacing 0.01,
+/// 1, 100) is no longer judged by its largest coordinate times its largest
+/// inverse spacing (issue 73). Never more than float32_clearance / 4.
+double float32_rounding(const Lattice& lattice, double reach = 2);
+
 /// Squared distance from p to the closed triangle (a, b, c).
 double point_triangle_distance2(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 

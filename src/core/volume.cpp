@@ -202,8 +202,22 @@ BinaryVolume select_samples(const ScalarVolume& v, const Selection& sel) {
       return select_any_component(v, [t](double x) { return x >= t; });
     }
     case K::segment: {
+      // An ID names one segment; a name two segments share is ambiguous (one
+      // was picked silently, issue 73).
+      const Segment* chosen = nullptr;
+      for (const Segment& s : v.segments)
+        if (s.id == sel.segment) chosen = &s;
+      if (!chosen) {
+        for (const Segment& s : v.segments)
+          if (s.name == sel.segment) {
+            if (chosen)
+              throw InputError(v.source, "segment name '" + sel.segment + "' is shared by segments " + chosen->id +
+                                             " and " + s.id + "; choose one by its ID with --segment ID");
+            chosen = &s;
+          }
+      }
       for (const Segment& s : v.segments) {
-        if (s.name == sel.segment || s.id == sel.segment) {
+        if (&s == chosen) {
           if (s.layer < 0 || s.layer >= v.components)
             throw InputError(v.source, "segment '" + sel.segment + "' names layer " + std::to_string(s.layer) +
                                            " but the file has " + std::to_string(v.components));

@@ -385,6 +385,7 @@ std::unique_ptr<Truth> resolve_truth(const std::string& spec, const ScalarVolume
     }
   // A mesh file: the stored transform applies when the volume was voxelized from a model.
   Mesh model = read_mesh(what);
+  require_solid(model, what);  // inside and outside, volume ratio: an open mesh has neither (issue 73)
   const std::string name = std::filesystem::path(what).filename().string();
   return mesh_truth(have_transform ? transformed(model, linear, translation) : std::move(model), name);
 }

@@ -65,7 +65,7 @@ BinaryVolume voxelize_on(const Mesh& mesh, const Lattice& L, Progress* progress)
   return out;
 }
 
-Voxelized voxelize(const Mesh& model, const VoxelizeOptions& o, const std::string& source) {
+void require_solid(const Mesh& model, const std::string& source) {
   model.validate(source);
   if (model.triangles.empty()) throw InputError(source, "the mesh has no triangles");
   MeshCheckOptions mo;
@@ -77,6 +77,10 @@ Voxelized voxelize(const Mesh& model, const VoxelizeOptions& o, const std::strin
   if (c.nonmanifold_edges) throw InputError(source, std::to_string(c.nonmanifold_edges) + " non-manifold edges");
   if (c.misoriented_edges)
     throw InputError(source, "inconsistently oriented faces (" + std::to_string(c.misoriented_edges) + " edges)");
+}
+
+Voxelized voxelize(const Mesh& model, const VoxelizeOptions& o, const std::string& source) {
+  require_solid(model, source);
   // Rotated bounding box from the vertices (exact for a polyhedron).
   Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
   for (const Vec3& p : model.positions) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 
 namespace voxpress::detail {
 
@@ -88,31 +89,43 @@ std::vector<std::byte> read_range(const std::string& path, uint64_t offset, uint
   return buf;
 }
 
-void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected) {
+// A deflate stream expands at most 1032:1 (a 258-byte match in about two
+// bits); a payload declaring more cannot hold it and is refused before any
+// allocation or inflation (issue 73: a 24-byte gzip declaring 512 MiB).
+void check_ratio(const std::string& path, size_t in_size, uint64_t expected) {
+  const uint64_t most = (uint64_t(in_size) + 64) * kMaxDeflateRatio;
+  if (expected > most)
+    throw InputError(path, "the compressed payload has " + std::to_string(in_size) + " bytes, which can hold at most " +
+                               std::to_string(most) + " (deflate expands at most " + std::to_string(kMaxDeflateRatio) +
+                               ":1), but the header declares " + std::to_string(expected));
+}
+
+void inflate_stream(const std::string& path, const std::byte* in, size_t in_size, uint64_t expected,
+                    const std::function<void(const std::byte*, size_t)>& sink, bool more_allowed) {
   z_stream zs{};
   if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(path, "zlib initialisation failed");
   struct Guard {
     z_stream* z;
     ~Guard() { inflateEnd(z); }
   } guard{&zs};
+  std::vector<std::byte> scratch(size_t(1) << 20);
   uint64_t produced = 0;
   size_t consumed = 0;
-  const uInt kChunk = 1u << 30;
+  bool ended = false;
   for (;;) {
     zs.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(in + consumed));
-    zs.avail_in = uInt(std::min<size_t>(in_size - consumed, kChunk));
-    unsigned char probe;
-    const bool full = produced == expected;
-    zs.next_out = full ? &probe : reinterpret_cast<Bytef*>(out + produced);
-    zs.avail_out = full ? 1u : uInt(std::min<uint64_t>(expected - produced, kChunk));
-    const uInt before_in = zs.avail_in, before_out = zs.avail_out;
+    zs.avail_in = uInt(std::min<size_t>(in_size - consumed, size_t(1) << 30));
+    zs.next_out = reinterpret_cast<Bytef*>(scratch.data());
+    zs.avail_out = uInt(scratch.size());
+    const uInt before_in = zs.avail_in;
     const int rc = inflate(&zs, Z_NO_FLUSH);
     consumed += before_in - zs.avail_in;
-    const uInt wrote = before_out - zs.avail_out;
-    if (full && wrote > 0)
+    const size_t wrote = scratch.size() - zs.avail_out;
+    if (!more_allowed && wrote > expected - produced)
       throw InputError(path, "the compressed payload holds more than the " + std::to_string(expected) +
                                  " bytes the header declares (dimensions or type do not match the data)");
-    produced += full ? 0 : wrote;
+    if (wrote) sink(scratch.data(), wrote);
+    produced += wrote;
     if (rc == Z_STREAM_END) {
       // Another gzip member may follow (concatenated gzip).
       size_t skip = consumed;
@@ -122,16 +135,48 @@ void inflate_exact(const std::string& path, const std::byte* in, size_t in_size,
         inflateReset(&zs);
         continue;
       }
+      ended = true;
       break;
     }
-    if (rc == Z_BUF_ERROR && consumed == in_size) break;  // input exhausted
     if (rc != Z_OK && rc != Z_BUF_ERROR)
       throw InputError(path, std::string("corrupt compressed payload (zlib: ") + (zs.msg ? zs.msg : "error") + ")");
-    if (consumed == in_size && zs.avail_out != 0 && wrote == 0) break;
+    if (consumed == in_size && wrote == 0) break;  // input exhausted before the stream's end
   }
   if (produced < expected)
     throw InputError(path, "truncated: the compressed payload holds " + std::to_string(produced) +
                                " bytes but the header declares " + std::to_string(expected));
+  if (!ended)
+    throw InputError(path, "truncated: the compressed payload ends before its end marker and check value "
+                           "(a gzip without its CRC trailer)");
+}
+
+void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected) {
+  check_ratio(path, in_size, expected);
+  uint64_t at = 0;
+  inflate_stream(path, in, in_size, expected, [&](const std::byte* p, size_t n) {
+    std::memcpy(out + at, p, n);
+    at += n;
+  }, false);
+}
+
+std::vector<std::byte> inflate_grown(const std::string& path, const std::byte* in, size_t in_size, uint64_t expected) {
+  check_ratio(path, in_size, expected);
+  // A single gzip member ends with its length modulo 2^32. When that is not
+  // the declared size (another length, several members, padding), the stream
+  // is first inflated without keeping anything, so a payload holding more or
+  // less than declared is refused before the buffer exists (16 MiB of
+  // gzipped zeros declaring 1 GiB peaked at 1.06 GB).
+  const bool gzip = in_size >= 18 && in[0] == std::byte{0x1f} && in[1] == std::byte{0x8b};
+  uint32_t isize = 0;
+  if (gzip)
+    for (int b = 3; b >= 0; --b) isize = (isize << 8) | uint32_t(in[in_size - 4 + size_t(b)]);
+  if (!gzip || isize != uint32_t(expected)) inflate_stream(path, in, in_size, expected, [](const std::byte*, size_t) {}, false);
+  // Reserved, not filled: the pages are touched as the data arrives.
+  std::vector<std::byte> out;
+  out.reserve(expected);
+  inflate_stream(path, in, in_size, expected, [&](const std::byte* p, size_t n) { out.insert(out.end(), p, p + n); },
+                 false);
+  return out;
 }
 
 std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzip_wrapper, int level) {
@@ -166,10 +211,17 @@ void swap_bytes(std::byte* data, uint64_t count, size_t width) {
   for (uint64_t i = 0; i < count; ++i) std::reverse(data + i * width, data + (i + 1) * width);
 }
 
+std::string format_bytes(uint64_t bytes) {
+  // "--max-memory 1K" said "needs 0 MiB, above the limit of 0 MiB" (issue 73).
+  if (bytes >= (uint64_t(1) << 20)) return std::to_string(bytes >> 20) + " MiB";
+  if (bytes >= 1024) return std::to_string(bytes >> 10) + " KiB";
+  return std::to_string(bytes) + " bytes";
+}
+
 void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what) {
   if (cap && bytes > cap)
-    throw LimitError(path, what + " needs " + std::to_string(bytes >> 20) + " MiB, above the memory limit of " +
-                               std::to_string(cap >> 20) + " MiB (raise it with --max-memory)");
+    throw LimitError(path, what + " needs " + format_bytes(bytes) + ", above the memory limit of " + format_bytes(cap) +
+                               " (raise it with --max-memory)");
 }
 
 uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
@@ -253,7 +305,41 @@ void remove_stale_temporaries(const fs::path& dir, const std::string& prefix) {
 namespace {
 // The open OutputGroup's pending (temporary, name) pairs; null when none is open.
 thread_local std::vector<std::pair<fs::path, fs::path>>* g_pending = nullptr;
+
+// The temporaries that exist now, in fixed storage a signal handler may read
+// (SIGINT / SIGTERM during a write left the hidden .tmpPID file, issue 73).
+constexpr size_t kTemporarySlots = 512, kTemporaryPath = 4096;
+char g_temporaries[kTemporarySlots][kTemporaryPath];
+std::atomic<bool> g_temporary_used[kTemporarySlots];
+std::mutex g_temporary_mutex;
+
+void track_temporary(const fs::path& tmp) {
+  const std::string p = tmp.string();
+  if (p.size() >= kTemporaryPath) return;  // not cleaned on a signal; the next run removes it
+  std::lock_guard lock(g_temporary_mutex);
+  for (size_t i = 0; i < kTemporarySlots; ++i)
+    if (!g_temporary_used[i].load()) {
+      std::memcpy(g_temporaries[i], p.c_str(), p.size() + 1);
+      g_temporary_used[i].store(true);
+      return;
+    }
+}
+
+void untrack_temporary(const fs::path& tmp) {
+  const std::string p = tmp.string();
+  std::lock_guard lock(g_temporary_mutex);
+  for (size_t i = 0; i < kTemporarySlots; ++i)
+    if (g_temporary_used[i].load() && p == g_temporaries[i]) {
+      g_temporary_used[i].store(false);
+      return;
+    }
+}
 }  // namespace
+
+void remove_temporaries_on_signal() noexcept {
+  for (size_t i = 0; i < kTemporarySlots; ++i)
+    if (g_temporary_used[i].load()) ::unlink(g_temporaries[i]);  // async-signal-safe
+}
 
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp)>& write) {
   static std::atomic<unsigned> counter{0};
@@ -269,6 +355,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
   name.append("-").append(std::to_string(counter++)).append(ext);
   const fs::path tmp = dir / name;
   remove_stale_temporaries(dir, std::string(".").append(target.filename().string()).append(".tmp"));
+  track_temporary(tmp);
   try {
     write(tmp.string());
     if (g_pending) {
@@ -276,6 +363,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
       for (auto& [t, final_name] : *g_pending)
         if (final_name == target) {
           fs::remove(t, ec);
+          untrack_temporary(t);
           t = tmp;
           return;
         }
@@ -284,8 +372,10 @@ void write_atomically(const std::string& path, const std::function<void(const st
     }
     fs::rename(tmp, target, ec);
     if (ec) throw InputError(path, "cannot write: " + ec.message());
+    untrack_temporary(tmp);
   } catch (...) {
     fs::remove(tmp, ec);
+    untrack_temporary(tmp);
     throw;
   }
 }
@@ -317,7 +407,10 @@ OutputGroup::OutputGroup() {
 OutputGroup::~OutputGroup() {
   if (!detail::g_pending) return;
   std::error_code ec;
-  for (const auto& [tmp, name] : *detail::g_pending) fs::remove(tmp, ec);
+  for (const auto& [tmp, name] : *detail::g_pending) {
+    fs::remove(tmp, ec);
+    detail::untrack_temporary(tmp);
+  }
   delete detail::g_pending;
   detail::g_pending = nullptr;
 }
@@ -328,6 +421,7 @@ void OutputGroup::commit_open() {
   for (size_t i = 0; i < pending->size(); ++i) {
     std::error_code ec;
     fs::rename((*pending)[i].first, (*pending)[i].second, ec);
+    if (!ec) detail::untrack_temporary((*pending)[i].first);
     if (ec) {
       pending->erase(pending->begin(), pending->begin() + std::ptrdiff_t(i));
       throw InputError((*pending)[0].second.string(), "cannot write: " + ec.message());
@@ -337,4 +431,21 @@ void OutputGroup::commit_open() {
 }
 
 void OutputGroup::commit() { commit_open(); }
+
+namespace {
+extern "C" void remove_temporaries_and_die(int sig) {
+  detail::remove_temporaries_on_signal();
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+}  // namespace
+
+void remove_temporaries_on_signals() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction sa {};
+    sa.sa_handler = remove_temporaries_and_die;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
 }  // namespace voxpress

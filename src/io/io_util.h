@@ -36,7 +36,26 @@ void read_range_into(const std::string& path, uint64_t offset, std::byte* out, u
 /// into exactly `expected` bytes without ever writing more: a stream that
 /// holds fewer bytes is "truncated", one that holds more is a size mismatch.
 /// Throws InputError(path, ...).
+/// A payload that cannot hold `expected` bytes (kMaxDeflateRatio:1) is refused.
+void check_ratio(const std::string& path, size_t in_size, uint64_t expected);
+/// Inflates a gzip or zlib stream (auto-detected; gzip members may follow one
+/// another), handing the output to `sink` in pieces of at most 1 MiB. Throws
+/// InputError(path, ...) when the stream holds fewer than `expected` bytes, is
+/// corrupt, ends before its end marker and check value (a gzip without its
+/// CRC trailer was accepted), or — unless `more_allowed` — holds more (before
+/// passing them on).
+void inflate_stream(const std::string& path, const std::byte* in, size_t in_size, uint64_t expected,
+                    const std::function<void(const std::byte*, size_t)>& sink, bool more_allowed);
+/// A payload that cannot hold `expected` bytes (deflate expands at most
+/// kMaxDeflateRatio:1) and a stream ending before its end marker and check
+/// value (a gzip without its CRC trailer) are refused too.
 void inflate_exact(const std::string& path, const std::byte* in, size_t in_size, std::byte* out, uint64_t expected);
+/// The same into a new buffer whose memory follows the data as it arrives
+/// (reserved, not filled); a gzip whose length trailer is not `expected` is
+/// first inflated without keeping anything, so a payload holding more or
+/// less than declared is refused before the buffer exists.
+std::vector<std::byte> inflate_grown(const std::string& path, const std::byte* in, size_t in_size, uint64_t expected);
+inline constexpr uint64_t kMaxDeflateRatio = 1032;
 /// gzip (wrapper = 16 + 15) or zlib (15) compression of a buffer.
 std::vector<std::byte> deflate_buffer(const std::byte* in, size_t size, bool gzip_wrapper, int level = 1);
 
@@ -52,6 +71,8 @@ void swap_bytes(std::byte* data, uint64_t count, size_t width);
 /// must be before it is converted to an integer (NaN never is).
 inline bool whole_in(double x, double lo, double hi) { return x >= lo && x <= hi && x == std::floor(x); }
 
+/// A size for a message: "12 MiB", "3 KiB" or "100 bytes".
+std::string format_bytes(uint64_t bytes);
 /// Throws LimitError(path, ...) if `bytes` exceeds the cap (0 = no cap).
 void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);
 /// dims product with overflow check; throws InputError on absurd dimensions.
@@ -68,6 +89,8 @@ std::string format_typed(ScalarType t, double x);
 double parse_double(const std::string& path, const std::string& text, const std::string& what);
 int64_t parse_int(const std::string& path, const std::string& text, const std::string& what);
 
+/// Unlinks every temporary of a write in progress; async-signal-safe.
+void remove_temporaries_on_signal() noexcept;
 /// Writes a file atomically: `write` receives the path of a temporary file in
 /// the destination folder (same extension, so format-sniffing libraries see
 /// the right suffix); on success it is renamed over `path`, on any exception

@@ -151,8 +151,12 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   for (const char* k : {"binarydatabyteordermsb", "elementbyteordermsb"})
     if (const auto* b = get(k)) big = truthy(*b);
   const bool compressed = get("compresseddata") && truthy(*get("compresseddata"));
+  // ASCII data (BinaryData = False) was refused as "data size does not match" (issue 73).
+  if (const auto* bd = get("binarydata"); bd && !truthy(*bd))
+    throw InputError(path, "BinaryData = " + *bd + ": text (ASCII) MetaImage data is not supported");
   int64_t header_size = 0;
   if (const auto* hs = get("headersize")) header_size = parse_int(path, *hs, "HeaderSize");
+  if (header_size < -1) throw InputError(path, "HeaderSize is " + std::to_string(header_size) + " (must be -1 or more)");
 
   const std::string& df = *get("elementdatafile");
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
@@ -167,7 +171,11 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   } else {
     sources.push_back({(base / df).string(), 0});
   }
-  v.bytes.resize(bytes);
+  // Named from the header the user gave, with the file it is missing (an MHD
+  // named only its data file).
+  for (const auto& src : sources)
+    if (std::error_code ec; !std::filesystem::exists(src.first, ec))
+      throw InputError(path, "its data file " + src.first + " does not exist");
   if (compressed) {
     std::vector<std::byte> z;
     for (const auto& [file, off] : sources) {
@@ -181,8 +189,9 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
       const int64_t n = parse_int(path, *cs, "CompressedDataSize");
       if (n > 0 && uint64_t(n) < z.size()) z.resize(size_t(n));
     }
-    inflate_exact(path, z.data(), z.size(), v.bytes.data(), bytes);
+    v.bytes = inflate_grown(path, z.data(), z.size(), bytes);
   } else {
+    v.bytes.resize(bytes);
     if (sources.size() > 1 && bytes % sources.size()) throw InputError(path, "LIST files cannot split the data evenly");
     const uint64_t per = bytes / sources.size();
     for (size_t i = 0; i < sources.size(); ++i) {

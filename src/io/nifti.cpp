@@ -96,8 +96,9 @@ T field(const std::vector<unsigned char>& b, size_t at, bool swap) {
 
 // Validates what nifti_clib relies on: the header size (and from it the
 // version and byte order), dim[0] in 1..7, positive extents, a known data
-// type and a sane data offset.
-void check_header(const std::string& path) {
+// type and a sane data offset; and that no field placing or scaling the
+// samples is infinite or NaN. Returns vox_offset.
+uint64_t check_header(const std::string& path) {
   const auto b = head_bytes(path, 540);
   if (b.size() < 348) throw InputError(path, "truncated: too small for a NIfTI header");
   const int32_t size = field<int32_t>(b, 0, false), swapped = field<int32_t>(b, 0, true);
@@ -118,8 +119,62 @@ void check_header(const std::string& path) {
   const int dt = field<int16_t>(b, v2 ? 12 : 70, swap);
   (void)from_datatype(path, dt);
   const double offset = v2 ? double(field<int64_t>(b, 168, swap)) : double(field<float>(b, 108, swap));
-  if (!(offset >= 0 && offset < 0x1p40))
-    throw InputError(path, "invalid NIfTI header: vox_offset is " + std::to_string(offset));
+  if (!(offset >= 0 && offset < 0x1p40) || offset != std::floor(offset))
+    throw InputError(path, "invalid NIfTI header: vox_offset is " + format_double(offset));
+  // Every value that places or scales the samples must be a number: nifti_clib
+  // would replace an infinite offset by 0 or drop a NaN scaling (issue 73).
+  auto real = [&](size_t at1, size_t at2) { return v2 ? field<double>(b, at2, swap) : double(field<float>(b, at1, swap)); };
+  auto require_finite = [&](const std::string& name, double x) {
+    if (!std::isfinite(x)) throw InputError(path, "invalid NIfTI header: " + name + " is " + format_double(x));
+  };
+  for (int d = 1; d <= std::min<int64_t>(dim[0], 3); ++d)
+    require_finite("pixdim[" + std::to_string(d) + "]", real(76 + 4 * size_t(d), 104 + 8 * size_t(d)));
+  const char* axis = "xyz";
+  for (size_t a = 0; a < 3; ++a) {
+    require_finite(std::string("quatern_") + "bcd"[a], real(256 + 4 * a, 352 + 8 * a));
+    require_finite(std::string("qoffset_") + axis[a], real(268 + 4 * a, 376 + 8 * a));
+    for (size_t c = 0; c < 4; ++c)
+      require_finite(std::string("srow_") + axis[a] + "[" + std::to_string(c) + "]",
+                     real(280 + 16 * a + 4 * c, 400 + 32 * a + 8 * c));
+  }
+  // Scaling: a slope of 0 means none (the standard), as does nibabel's NaN
+  // slope with a NaN or zero intercept; any other non-finite value is refused.
+  const double slope = real(112, 176), inter = real(116, 184);
+  const bool unscaled_nan = std::isnan(slope) && (std::isnan(inter) || inter == 0);
+  if (!unscaled_nan) {
+    require_finite("scl_slope", slope);
+    if (slope != 0) require_finite("scl_inter", inter);
+  }
+  return uint64_t(offset);
+}
+
+// The samples of a gzipped single-file NIfTI, inflated by us rather than by
+// nifti_clib's gzread, which accepted a stream without its CRC trailer and
+// allocated the declared size up front: the payload must be able to hold the
+// declared data (at most 1032:1), the buffer grows as the data arrives, and
+// the stream must end with its check value (issue 73).
+std::vector<std::byte> load_gzipped(const std::string& path, const nifti_image& nim, uint64_t count, size_t vs,
+                                    uint64_t max_bytes) {
+  const uint64_t fsize = file_size(path);
+  check_limit(path, fsize, max_bytes, "the compressed file");
+  const std::vector<std::byte> z = read_range(path, 0, fsize);
+  const uint64_t offset = uint64_t(nim.iname_offset), bytes = count * vs;
+  check_ratio(path, z.size(), offset + bytes);
+  std::vector<std::byte> out;
+  out.reserve(bytes);
+  uint64_t at = 0;  // position in the inflated stream
+  inflate_stream(path, z.data(), z.size(), offset + bytes, [&](const std::byte* p, size_t n) {
+    const uint64_t lo = std::max(at, offset), hi = std::min(at + n, offset + bytes);
+    if (lo < hi) out.insert(out.end(), p + (lo - at), p + (hi - at));
+    at += n;
+  }, true);  // bytes after the samples are ignored, as for a .nii
+  if (nim.byteorder != nifti_short_order()) swap_bytes(out.data(), count, vs);
+  return out;
+}
+
+bool gzipped(const std::string& path) {
+  const auto b = read_range(path, 0, std::min<uint64_t>(file_size(path), 2));
+  return b.size() == 2 && b[0] == std::byte{0x1f} && b[1] == std::byte{0x8b};
 }
 
 }  // namespace
@@ -129,9 +184,17 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   const uint64_t fsize = file_size(path);
   const std::string ext = extension_of(path);
   if (ext != ".nii.gz" && fsize < 348) throw InputError(path, "truncated: too small for a NIfTI header");
-  check_header(path);
+  const uint64_t vox_offset = check_header(path);
   NimPtr nim(nifti_image_read(path.c_str(), 0));
   if (!nim) throw InputError(path, "not a readable NIfTI-1/2 file (bad or truncated header)");
+  // nifti_clib reads from the end of the header when vox_offset does not fit
+  // its int (1e12): the data would come from the wrong place (issue 73).
+  const bool single = nim->iname && nim->fname && std::strcmp(nim->iname, nim->fname) == 0;
+  if (single && vox_offset > uint64_t(nim->iname_offset))
+    throw InputError(path, "invalid NIfTI header: vox_offset " + std::to_string(vox_offset) +
+                               (ext == ".nii" && vox_offset > fsize ? " is beyond the end of the file (" +
+                                                                          std::to_string(fsize) + " bytes)"
+                                                                    : " cannot be honoured"));
   ScalarVolume v;
   v.source = path;
   for (int d = 4; d <= 7; ++d)
@@ -145,7 +208,7 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   if (uint64_t(nim->nvox) != count) throw InputError(path, "inconsistent NIfTI dimensions");
   check_limit(path, count * vs, max_bytes, "the volume");
   // For an uncompressed single file the payload size is known up front.
-  if (ext == ".nii" && nim->iname && std::strcmp(nim->iname, nim->fname) == 0) {
+  if (ext == ".nii" && single) {
     const uint64_t need = uint64_t(nim->iname_offset) + count * vs;
     if (fsize < need)
       throw InputError(path, "truncated: the header declares " + std::to_string(count * vs) + " bytes of data at offset " +
@@ -179,18 +242,24 @@ ScalarVolume read_nifti(const std::string& path, uint64_t max_bytes) {
   } catch (const UsageError& e) {
     throw InputError(path, e.what());
   }
-  if (nifti_image_load(nim.get()) != 0 || !nim->data)
-    throw InputError(path, "truncated or corrupt NIfTI image data");
+  std::vector<std::byte> data;
+  if (single && gzipped(path)) {
+    data = load_gzipped(path, *nim, count, vs, max_bytes);
+  } else {
+    if (nifti_image_load(nim.get()) != 0 || !nim->data)
+      throw InputError(path, "truncated or corrupt NIfTI image data");
+    data.assign(static_cast<const std::byte*>(nim->data), static_cast<const std::byte*>(nim->data) + count * vs);
+    nifti_image_unload(nim.get());
+  }
   const bool scaled = nim->scl_slope != 0 && std::isfinite(nim->scl_slope) &&
                       (nim->scl_slope != 1 || nim->scl_inter != 0);
   if (!scaled) {
-    v.bytes.resize(count * vs);
-    std::memcpy(v.bytes.data(), nim->data, count * vs);
+    v.bytes = std::move(data);
     return v;
   }
   // Apply the scaling: y = slope * x + inter.
   ScalarVolume raw = v;
-  raw.bytes.assign(static_cast<const std::byte*>(nim->data), static_cast<const std::byte*>(nim->data) + count * vs);
+  raw.bytes = std::move(data);
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   nim.reset();
   v.type = vs == 8 ? ScalarType::f64 : ScalarType::f32;

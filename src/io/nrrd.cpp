@@ -247,10 +247,13 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     if (int64_t(tok.size()) != dim) throw InputError(path, "'spacings' does not list 'dimension' values");
     for (int a = 0; a < dim - first; ++a) {
       const double s = parse_double(path, tok[size_t(first + a)], "spacings");
-      if (std::isfinite(s) && s != 0) {
-        v.lattice.spacing[a] = std::abs(s);
-        if (s < 0) v.lattice.direction.col(a) *= -1;
-      }
+      // No silent default: a spatial axis's spacing is a finite non-zero number
+      // (negative flips the axis, as teem reads it) (issue 73).
+      if (!std::isfinite(s) || s == 0)
+        throw InputError(path, "'spacings' gives spatial axis " + std::to_string(first + a) + " the spacing " +
+                                   tok[size_t(first + a)] + " (must be a finite non-zero number)");
+      v.lattice.spacing[a] = std::abs(s);
+      if (s < 0) v.lattice.direction.col(a) *= -1;
     }
   }
   if (const auto* o = field(h, {"space origin"})) {
@@ -279,6 +282,8 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     };
     s.name = get("_Name") ? *get("_Name") : value;
     if (const auto* lv = get("_LabelValue")) s.label = parse_double(path, *lv, prefix + "_LabelValue");
+    // A NaN label matches no sample: the segment was dropped from --labels all (issue 73).
+    if (!std::isfinite(s.label)) throw InputError(path, prefix + "_LabelValue is " + format_double(s.label) + ", not a label");
     if (const auto* ly = get("_Layer")) s.layer = parse_int(path, *ly, prefix + "_Layer");
     v.segments.push_back(s);
   }
@@ -294,6 +299,13 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
   int64_t line_skip = 0, byte_skip = 0;
   if (const auto* s = field(h, {"line skip", "lineskip"})) line_skip = parse_int(path, *s, "line skip");
   if (const auto* s = field(h, {"byte skip", "byteskip"})) byte_skip = parse_int(path, *s, "byte skip");
+  // -1 (the data is the file's last bytes) is the one negative value NRRD
+  // defines, for raw data only; -5 was read as 0 (issue 73).
+  if (line_skip < 0) throw InputError(path, "'line skip' is " + std::to_string(line_skip) + " (must be 0 or more)");
+  if (byte_skip < -1 || (byte_skip == -1 && enc != "raw"))
+    throw InputError(path, "'byte skip' is " + std::to_string(byte_skip) +
+                               (byte_skip == -1 ? " with " + enc + " encoding (-1 applies to raw data only)"
+                                                : " (must be -1 or more)"));
 
   // Data sources: (file, offset) pairs; attached data lives after the header.
   std::vector<std::string> files;
@@ -365,7 +377,6 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     for (size_t f = 0; f < parts.size(); ++f)
       read_range_into(parts[f].file, parts[f].offset, v.bytes.data() + f * per_file, per_file);
   } else if (enc == "gzip" || enc == "gz") {
-    v.bytes.resize(bytes);
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
     std::vector<std::byte> compressed;
     for (const auto& file : sources) {
@@ -376,17 +387,31 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
       auto part = read_range(file, off, fsize - off);
       compressed.insert(compressed.end(), part.begin(), part.end());
     }
-    inflate_exact(path, compressed.data(), compressed.size(), v.bytes.data(), bytes);
+    v.bytes = inflate_grown(path, compressed.data(), compressed.size(), bytes);
   } else if (enc == "text" || enc == "txt" || enc == "ascii") {
-    v.bytes.resize(bytes);
-    std::string text;
     const std::vector<std::string> sources = attached ? std::vector<std::string>{path} : files;
+    std::vector<std::pair<std::string, uint64_t>> parts;  // file, offset
+    uint64_t text_bytes = 0;
     for (const auto& file : sources) {
-      const uint64_t off = data_start(file);
+      parts.push_back({file, data_start(file)});
+      text_bytes += file_size(file) - parts.back().second;
+    }
+    // Each value takes a character and a separator: a payload shorter than
+    // that cannot hold the declared values (issue 73: 100 bytes declaring 2^29
+    // values allocated 538 MB before failing). The samples are allocated only then.
+    if (count > (text_bytes + 1) / 2)
+      throw InputError(path, "truncated: the text payload has " + std::to_string(text_bytes) +
+                                 " bytes, too few for the " + std::to_string(count) +
+                                 " values the header declares (at least 2 bytes each)");
+    check_limit(path, text_bytes, max_bytes, "the text payload");
+    std::string text;
+    text.reserve(text_bytes + parts.size());
+    for (const auto& [file, off] : parts) {
       const auto part = read_range(file, off, file_size(file) - off);
       text.append(reinterpret_cast<const char*>(part.data()), part.size());
       text.push_back('\n');
     }
+    v.bytes.resize(bytes);
     parse_text(path, text, v);
     big = false;  // already native
   } else if (enc == "bzip2" || enc == "bz2" || enc == "hex") {

@@ -8,13 +8,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <fstream>
 #include <mutex>
 #include <span>
 #include <sstream>
 #include <type_traits>
 #include <unordered_map>
 
+#include "../io/io_util.h"
 #include "voxpress/core/error.h"
 
 namespace voxpress {
@@ -250,15 +250,24 @@ std::vector<LabelInfo> select_labels(const LabelTable& table, const std::vector<
       for (size_t i = 0; i < table.labels.size() && i < 20; ++i)
         have += (i ? ", " : "") + format_value(table.labels[i].value);
       if (table.labels.size() > 20) have += ", ...";
-      throw InputError(source, "no sample has label " + format_value(value) + " (labels: " + have + ")");
+      // 0 is never a label (issue 73: "no sample has label 0" on a map full of zeros).
+      throw InputError(source, (value == 0 ? std::string("0 is the background, not a label")
+                                           : "no sample has label " + format_value(value)) +
+                                   " (labels: " + have + ")");
     }
   }
   return out;
 }
 
 std::map<double, std::string> read_label_names(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open the label-name table");
+  // A regular file of bounded size: a device (/dev/zero), a pipe or a folder
+  // would otherwise be read without end or silently give no names (issue 73).
+  const uint64_t size = detail::file_size(path);
+  if (size > kMaxLabelNamesBytes)
+    throw InputError(path, "the label-name table has " + std::to_string(size) + " bytes, more than the " +
+                               std::to_string(kMaxLabelNamesBytes >> 20) + " MiB a table of names can need");
+  const std::vector<std::byte> bytes = detail::read_range(path, 0, size);
+  std::istringstream in(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   std::map<double, std::string> names;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {

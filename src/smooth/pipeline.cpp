@@ -119,9 +119,10 @@ void require_float32_room(const Lattice& lattice, const SurfaceOptions& o, const
   // The output keeps the guarantee in float32 only if its rounding (delta / 4)
   // stays well inside the clearance the pressing margin gives every sample
   // (margin / sqrt(3)): a lattice far from the origin for its spacing cannot.
-  if (const double delta = detail::float32_clearance(lattice); delta > o.press.margin)
+  // The rounding is judged per axis (issue 73: spacing 0.01, 1, 100 was refused).
+  if (const double rounding = detail::float32_rounding(lattice); 4 * rounding > o.press.margin)
     throw InputError(source, "its coordinates are too large for its spacing to be stored in float32 with "
-                             "every sample on its side (rounding " + detail::format_double(delta / 4) +
+                             "every sample on its side (rounding " + detail::format_double(rounding) +
                              " cells; move the origin closer to the volume)");
 }
 

@@ -96,6 +96,11 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
   if (art.parts.empty()) throw InputError(art.source, "no voxel model to convert");
   if (!(options.lambda > 0 && options.lambda <= 2)) throw UsageError("--lambda must be in (0, 2]");
   if (!(options.chart_angle > 0 && options.chart_angle <= 90)) throw UsageError("--chart-angle must be in (0, 90]");
+  // A bad texture size was exit 1 (an input error) or accepted (issue 73).
+  if (options.max_texture < 1 || options.max_texture > (int64_t(1) << 16))
+    throw UsageError("--max-texture must be from 1 to 65536 texels");
+  if (options.texels_per_voxel < 0 || options.texels_per_voxel > 64)
+    throw UsageError("--texels-per-voxel must be from 1 to 64");
   if (options.padding < 1 || options.padding > 16) throw UsageError("--padding must be 1..16 texels");
 
   // 1. Solid and cuberille quads, per part.

@@ -120,6 +120,101 @@ Placement parse_frame(const std::string& path, const Dict& frame) {
   return p;
 }
 
+// What a scene-graph node places, computed without expanding it: how many
+// shape instances and the box of their painted voxels (a signed axis
+// permutation maps a box onto a box). A group listing one child twice,
+// nested 40 deep, places 2^40 instances from a 3 KB file (issue 73).
+struct Reach {
+  uint64_t instances = 0;  // saturating
+  bool any = false;        // some painted voxel
+  std::array<int64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+  void add(const Reach& o) {
+    instances = o.instances > UINT64_MAX - instances ? UINT64_MAX : instances + o.instances;
+    if (!o.any) return;
+    for (size_t a = 0; a < 3; ++a) {
+      lo[a] = any ? std::min(lo[a], o.lo[a]) : o.lo[a];
+      hi[a] = any ? std::max(hi[a], o.hi[a]) : o.hi[a];
+    }
+    any = true;
+  }
+  Reach placed(const Placement& p) const {
+    Reach r = *this;
+    if (!any) return r;
+    const auto a = p.apply(lo), b = p.apply(hi);
+    for (size_t i = 0; i < 3; ++i) r.lo[i] = std::min(a[i], b[i]), r.hi[i] = std::max(a[i], b[i]);
+    return r;
+  }
+};
+
+bool hidden(const SceneNode& n, const std::map<int32_t, bool>& hidden_layers) {
+  if (auto h = n.attributes.find("_hidden"); h != n.attributes.end() && h->second == "1") return true;
+  auto l = hidden_layers.find(n.layer);
+  return l != hidden_layers.end() && l->second;
+}
+
+// The Reach of node `root` (post-order with an explicit stack, each node
+// once; a node met again while in progress is a cycle). `models` gives each
+// model's Reach as one instance placed by centred().
+Reach scene_reach(const std::string& path, const std::map<int32_t, SceneNode>& nodes,
+                  const std::map<int32_t, bool>& hidden_layers, const std::vector<Reach>& models, int32_t root) {
+  std::map<int32_t, Reach> done;
+  std::map<int32_t, bool> open;
+  std::vector<std::pair<int32_t, bool>> stack{{root, false}};  // node, children already pushed
+  while (!stack.empty()) {
+    auto [id, expanded] = stack.back();
+    stack.pop_back();
+    if (done.count(id)) continue;
+    auto found = nodes.find(id);
+    if (found == nodes.end()) throw InputError(path, "scene node " + std::to_string(id) + " is referenced but missing");
+    const SceneNode& n = found->second;
+    const bool skip = n.kind == SceneNode::transform && hidden(n, hidden_layers);
+    if (!expanded && n.kind != SceneNode::shape && !skip) {
+      if (open[id]) throw InputError(path, "the scene graph has a cycle");
+      open[id] = true;
+      stack.push_back({id, true});
+      for (int32_t ch : n.children)
+        if (!done.count(ch)) stack.push_back({ch, false});
+      continue;
+    }
+    Reach r;
+    if (skip) {
+    } else if (n.kind == SceneNode::transform) {
+      r = done.at(n.children[0]).placed(parse_frame(path, n.frame));
+    } else if (n.kind == SceneNode::group) {
+      for (int32_t ch : n.children) r.add(done.at(ch));
+    } else {
+      for (int32_t m : n.children) {
+        if (m < 0 || size_t(m) >= models.size())
+          throw InputError(path, "shape node " + std::to_string(id) + " uses model " + std::to_string(m) +
+                                     " but the file has " + std::to_string(models.size()));
+        r.add(models[size_t(m)]);
+      }
+    }
+    open[id] = false;
+    done[id] = r;
+  }
+  return done.at(root);
+}
+
+// Refuses, before anything is expanded, a scene whose instances or grid do
+// not fit the cap: the instance list, and the grid with the buffers the
+// voxel-art pipeline keeps per cell (kVoxartBytesPerCell).
+void check_scene(const std::string& path, const Reach& reach, uint64_t cap) {
+  if (!reach.any) throw InputError(path, "the model is empty (no voxel)");
+  const uint64_t per_instance = 128;  // an Instance and its share of the walk
+  if (cap && reach.instances > cap / per_instance)
+    throw LimitError(path, "the scene graph places " +
+                               (reach.instances == UINT64_MAX ? std::string("more than 2^64") : std::to_string(reach.instances)) +
+                               " shape instances, above what the memory limit of " + format_bytes(cap) +
+                               " holds (raise it with --max-memory)");
+  std::array<int64_t, 3> dims{};
+  for (size_t a = 0; a < 3; ++a) dims[a] = reach.hi[a] - reach.lo[a] + 1;
+  const uint64_t cells = checked_count(path, dims, 1, kVoxartBytesPerCell);
+  check_limit(path, cells * kVoxartBytesPerCell, cap,
+              "the voxel grid of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+                  std::to_string(dims[2]) + " cells (" + std::to_string(kVoxartBytesPerCell) + " bytes each)");
+}
+
 }  // namespace
 
 VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
@@ -237,10 +332,27 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
     for (size_t a = 0; a < 3; ++a) q.t[a] = -(models[m].size[a] / 2);
     return q.then(p);
   };
+  if (options.model >= 0 && size_t(options.model) >= models.size())
+    throw UsageError(path + ": --model " + std::to_string(options.model) + " but the file has " +
+                     std::to_string(models.size()) + " model(s)");
+  // Each model as one instance, untransformed (its painted voxels' box), and
+  // as the scene graph's shapes place it (centred()).
+  std::vector<Reach> model_reach(models.size()), centred_reach(models.size());
+  for (size_t m = 0; m < models.size(); ++m) {
+    Reach& r = model_reach[m];
+    r.instances = 1;
+    for (const auto& v : models[m].voxels) {
+      if (v[3] == 0) continue;
+      const std::array<int64_t, 3> w{v[0], v[1], v[2]};
+      r.add(Reach{0, true, w, w});
+    }
+    centred_reach[m] = r.placed(centred(m, Placement{}));
+  }
+  const Reach reach = options.model >= 0 ? model_reach[size_t(options.model)]
+                      : nodes.count(0)   ? scene_reach(path, nodes, hidden_layers, centred_reach, 0)
+                                         : model_reach[0];
+  check_scene(path, reach, cap);
   if (options.model >= 0) {
-    if (size_t(options.model) >= models.size())
-      throw UsageError(path + ": --model " + std::to_string(options.model) + " but the file has " +
-                       std::to_string(models.size()) + " model(s)");
     instances.push_back({size_t(options.model), Placement{}});
     art.notes.push_back("model " + std::to_string(options.model) + " only, untransformed");
   } else if (nodes.count(0)) {
@@ -283,25 +395,11 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
                           " (animation frames; --model K picks another)");
   }
 
-  // One grid spanning every instance.
-  std::array<int64_t, 3> lo{INT64_MAX, INT64_MAX, INT64_MAX}, hi{INT64_MIN, INT64_MIN, INT64_MIN};
-  bool any = false;
-  for (const Instance& in : instances)
-    for (const auto& v : models[in.model].voxels) {
-      if (v[3] == 0) continue;
-      const auto w = in.place.apply({v[0], v[1], v[2]});
-      for (size_t a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], w[a]);
-        hi[a] = std::max(hi[a], w[a]);
-      }
-      any = true;
-    }
-  if (!any) throw InputError(path, "the model is empty (no voxel)");
+  // One grid spanning every instance (its box and size checked above).
+  const std::array<int64_t, 3>& lo = reach.lo;
   ColorGrid g;
-  for (size_t a = 0; a < 3; ++a) g.dims[a] = hi[a] - lo[a] + 1;
-  const uint64_t cells = checked_count(path, g.dims, 1, sizeof(Rgba));
-  check_limit(path, cells * sizeof(Rgba), cap, "the voxel grid");
-  g.voxels.assign(cells, Rgba{0, 0, 0, 0});
+  for (size_t a = 0; a < 3; ++a) g.dims[a] = reach.hi[a] - lo[a] + 1;
+  g.voxels.assign(uint64_t(g.dims[0]) * uint64_t(g.dims[1]) * uint64_t(g.dims[2]), Rgba{0, 0, 0, 0});
   g.offset = Vec3(double(lo[0]), double(lo[1]), double(lo[2]));
   g.name = std::filesystem::path(path).stem().string();
   for (const Instance& in : instances)

@@ -70,7 +70,13 @@ std::vector<std::pair<std::string, Matrix34>> read_hva(const std::string& vxl_pa
   for (auto& s : out) s.first = section_name(c.text(16, "section names"));
   c.skip(size_t(frame) * sections * 48, "frames");
   for (auto& s : out)
-    for (float& v : s.second) v = c.f32("frame matrices");
+    for (float& v : s.second) {
+      v = c.f32("frame matrices");
+      // A NaN reached the atlas as "a texture chart would exceed 10^9 texels", no file named (issue 73).
+      if (!std::isfinite(v))
+        throw InputError(hva, "section '" + s.first + "' frame " + std::to_string(frame) + ": the matrix holds " +
+                                  format_double(v) + ", not a finite number");
+    }
   notes.push_back("placed by " + std::filesystem::path(hva).filename().string() + " frame " + std::to_string(frame) +
                   " of " + std::to_string(frames));
   return out;
@@ -130,7 +136,7 @@ VoxelArt read_vxl(const std::string& path, const VoxelArtReadOptions& options) {
       throw InputError(path, where + ": transform or bounds are not finite");
     const uint64_t cells = uint64_t(g.dims[0]) * uint64_t(g.dims[1]) * uint64_t(g.dims[2]);
     total_cells += cells;
-    check_limit(path, total_cells * sizeof(Rgba), cap, "the voxel grids");
+    check_limit(path, total_cells * kVoxartBytesPerCell, cap, "the voxel grids (" + std::to_string(kVoxartBytesPerCell) + " bytes per cell)");
     g.voxels.assign(cells, Rgba{0, 0, 0, 0});
     ByteCursor starts(path, data, body + start_off, body + start_off + columns * 4);
     ByteCursor ends(path, data, body + end_off, body + end_off + columns * 4);

@@ -101,5 +101,32 @@ TEST(Clearance, Float32MarginCoversTheRounding) {
   EXPECT_LT(delta, 0.01) << "and far below the pressing margin of 0.01 cell";
 }
 
+// Per axis (issue 73): an anisotropic lattice's rounding is bounded on each
+// axis by its own coordinates, never above the whole-lattice bound, and
+// still at least every rounding seen.
+TEST(Clearance, Float32RoundingPerAxisCoversTheRounding) {
+  test::Rng rng(9);
+  for (int t = 0; t < 4; ++t) {
+    Lattice l;
+    l.dims = {16, 16, 16};
+    l.spacing = Vec3(0.01, 1, 100);
+    if (t >= 2) l.origin = Vec3(3, -40, 2000 * t);
+    if (t % 2) l.direction = Eigen::AngleAxisd(0.3 * t, Vec3(1, -2, 3).normalized()).toRotationMatrix();
+    const double rounding = detail::float32_rounding(l);
+    EXPECT_LE(rounding, detail::float32_clearance(l) / 4 * 1.0000001);
+    double worst = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const Vec3 ijk(rng.uniform() * 17 - 1, rng.uniform() * 17 - 1, rng.uniform() * 17 - 1);
+      worst = std::max(worst, (l.to_index(l.to_physical(ijk).cast<float>().cast<double>()) - ijk).norm());
+    }
+    EXPECT_GT(worst, 0);
+    EXPECT_LE(worst, rounding) << t;
+    if (t == 0) {
+      EXPECT_LT(4 * rounding, 0.01) << "room enough for the pressing margin";
+      EXPECT_GT(detail::float32_clearance(l), 0.01) << "which the whole-lattice bound refused";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace voxpress

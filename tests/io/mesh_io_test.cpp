@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
+
 #include "test_util.h"
 
 namespace voxpress {
@@ -241,6 +243,36 @@ TEST(MeshIO, OutputGroupWritesEverythingOrNothing) {
   ASSERT_EQ(waitpid(pid, &status, 0), pid);
   for (const std::string& f : tmp.files()) EXPECT_FALSE(f.starts_with("k.")) << f;
   EXPECT_THROW({ OutputGroup a; OutputGroup b; }, std::logic_error);
+}
+
+// SIGINT / SIGTERM in the middle of a write left the hidden temporary (issue
+// 73): with remove_temporaries_on_signals() (the CLI installs it) the process
+// still dies by the signal, and neither the temporary nor the name is left,
+// for a plain write and for one pending in an uncommitted group.
+TEST(MeshIO, SignalsWhileWritingLeaveNoTemporary) {
+  test::TempDir tmp;
+  for (int sig : {SIGTERM, SIGINT}) {
+    for (bool grouped : {false, true}) {
+      SCOPED_TRACE(std::to_string(sig) + (grouped ? " grouped" : ""));
+      const pid_t pid = fork();
+      ASSERT_GE(pid, 0);
+      if (pid == 0) {
+        remove_temporaries_on_signals();
+        std::unique_ptr<OutputGroup> group(grouped ? new OutputGroup : nullptr);
+        if (grouped) write_file_atomically(tmp.path("done.json"), [](std::ostream& o) { o << "{}"; });
+        write_file_atomically(tmp.path("s.json"), [&](std::ostream& o) {
+          o << "{\"partial\": ";
+          o.flush();
+          ::raise(sig);  // in the middle of the write
+        });
+        _exit(0);
+      }
+      int status = 0;
+      ASSERT_EQ(waitpid(pid, &status, 0), pid);
+      EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status;
+      EXPECT_TRUE(tmp.files().empty()) << (tmp.files().empty() ? "" : tmp.files()[0]);
+    }
+  }
 }
 
 TEST(MeshIO, FailedWritesLeaveNoFile) {

@@ -250,7 +250,7 @@ TEST(VolumeIO, BadInputsGetOneLineErrorsNamingTheFile) {
     const auto size = fs::file_size(tmp.path(name));
     fs::resize_file(tmp.path(name), size - 300);
     SCOPED_TRACE(name);
-    expect_input_error([&] { read_volume(tmp.path(name)); }, name, name.ends_with(".nii.gz") ? "corrupt" : "truncated");
+    expect_input_error([&] { read_volume(tmp.path(name)); }, name, "truncated");
   }
   // Header dimensions that do not match the data.
   test::write_file(tmp.path("big.nrrd"),

@@ -118,6 +118,9 @@ def test_bad_arguments_raise_clear_exceptions():
     (dict(spacing="1,1,1"), "sequence of 3 numbers"),
     (dict(spacing=(1e150, 1, 1)), "spacing"),
     (dict(origin=(float("inf"), 0, 0)), "origin"),
+    (dict(iterations=float("nan")), "iterations"),  # issue 73: bare cast RuntimeErrors before
+    (dict(iterations=10**30), "iterations"),
+    (dict(sharp_angle="wide"), "sharp_angle"),
 ])
 def test_out_of_range_options_are_the_libraries_usage_errors(kwargs, message):
     with pytest.raises(voxpress.UsageError, match=message):
@@ -262,3 +265,16 @@ def test_press_labels_every_label_at_once(tmp_path):
         voxpress.press_labels(labels, labels=[4, 5])
     with pytest.raises(voxpress.InputError):
         voxpress.press_labels(np.zeros((4, 4, 4), np.uint8))
+
+
+def test_press_labels_takes_all_as_the_command_line_does():
+    # issue 73: labels="all" raised a bare cast RuntimeError.
+    vol = np.zeros((12, 12, 12), np.uint16)
+    vol[2:10, 2:10, 2:6] = 7
+    vol[2:10, 2:10, 6:10] = 300
+    every = voxpress.press_labels(vol, labels="all")
+    assert len(every) == len(voxpress.press_labels(vol))
+    with pytest.raises(voxpress.UsageError, match="labels="):
+        voxpress.press_labels(vol, labels="7,300")
+    with pytest.raises(voxpress.UsageError, match="labels"):
+        voxpress.press_labels(vol, labels=[7, "x"])

@@ -46,6 +46,11 @@ struct Voxelized {
   Placement placement;
 };
 
+/// Throws InputError naming `source` unless the mesh is a solid: triangles,
+/// closed, 2-manifold, consistently oriented (what voxelize and a --truth
+/// mesh need; eval accepted an open truth and reported a volume ratio of 24.9).
+void require_solid(const Mesh& model, const std::string& source);
+
 /// Voxelizes a closed, 2-manifold, consistently oriented mesh. Throws
 /// InputError(source, ...) naming what is wrong otherwise (e.g. "412 boundary
 /// edges"). Inside = non-zero winding number, so either orientation works.

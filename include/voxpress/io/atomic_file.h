@@ -35,4 +35,10 @@ class OutputGroup {
   static void commit_open();
 };
 
+/// Installs SIGINT, SIGTERM and SIGHUP handlers that remove the temporaries
+/// of the writes in progress (and of a group not yet committed), then end the
+/// process by the same signal. SIGKILL cannot be caught: the next write of
+/// the same name removes what it leaves.
+void remove_temporaries_on_signals();
+
 }  // namespace voxpress

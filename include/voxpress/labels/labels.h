@@ -85,8 +85,10 @@ std::vector<LabelInfo> select_labels(const LabelTable& table, const std::vector<
 /// Reads a label-name table (one "VALUE NAME" per line, separated by blanks,
 /// a comma or a tab; '#' starts a comment) — the form TotalSegmentator and
 /// ITK-SNAP label descriptions reduce to. Throws InputError naming the file
-/// and the line.
+/// and the line; the file must be a regular file (not a folder, device or
+/// pipe) of at most kMaxLabelNamesBytes.
 std::map<double, std::string> read_label_names(const std::string& path);
+inline constexpr uint64_t kMaxLabelNamesBytes = uint64_t(16) << 20;
 
 /// The label's samples as a binary volume on its bounding box grown by one
 /// sample on each side (clipped to the lattice), with the lattice's origin
