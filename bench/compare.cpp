@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <chrono>
 #include <cstdio>
@@ -95,11 +96,13 @@ int main(int argc, char** argv) {
   std::string cli = "build/bin/voxpress", write, data = "../shared/data";
   bool quick = false;
   size_t samples = 200000;
+  std::vector<std::string> only;
   app.add_option("--cli", cli, "voxpress executable")->capture_default_str();
   app.add_option("--write", write, "Markdown file whose compare section is replaced");
   app.add_option("--data", data, "Shared data folder (meshes/ is used when present)")->capture_default_str();
   app.add_option("--samples", samples, "Area samples per direction")->capture_default_str();
   app.add_flag("--quick", quick, "Only 64 and 128 for generated shapes, 128 for meshes");
+  app.add_option("--only", only, "Only these methods (names as in the table, e.g. pressing midpoint)");
   CLI11_PARSE(app, argc, argv);
 
   const fs::path work = fs::temp_directory_path() / ("voxpress-compare-" + std::to_string(::getpid()));
@@ -120,6 +123,7 @@ int main(int argc, char** argv) {
 
   auto do_case = [&](Case& c) {
     for (const CliMethod& m : kMethods) {
+      if (!only.empty() && std::find(only.begin(), only.end(), m.name) == only.end()) continue;
       const std::string out = (work / (c.name + "-" + m.name + ".ply")).string();
       const std::string stats = (work / "stats.json").string();
       std::vector<std::string> args;

@@ -257,9 +257,9 @@ void run_press(const PressCmd& c, const Global& g) {
   const int iterations = pressing ? r.press.iterations : so.method == Method::cesn ? r.net.iterations : r.smooth.iterations;
   if (!g.quiet) {
     if (pressing)
-      std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %zu sharp edges, %d iterations (last max change %.2g)\n",
+      std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %zu flats (%zu frozen vertices, %zu junctions), %zu sharp edges, %d iterations (residual %.2g)\n",
                    c.output.c_str(), mesh.vertex_count(), mesh.face_count(), r.flats.flats.size(), r.flats.frozen_count(),
-                   size_t(r.flats.stats.junctions), mesh.edges.size(), iterations, r.press.last_max_change);
+                   size_t(r.flats.stats.junctions), mesh.edges.size(), iterations, r.press.residual);
     else
       std::fprintf(stderr, "%s: %zu vertices, %zu triangles, %s, %d iterations\n", c.output.c_str(), mesh.vertex_count(),
                    mesh.face_count(), c.method.c_str(), iterations);

@@ -1,0 +1,105 @@
+// Invariance: the same solid sampled on a shifted, padded or cropped lattice
+// (the origin moved so that every sample keeps its physical place) gives the
+// same t on every stick, through every pressing stage (issue 74, item 2).
+#include <array>
+#include <cmath>
+
+#include "test_util.h"
+
+namespace voxpress {
+namespace {
+
+// The volume with `lo` samples added before and `hi` after each axis (all
+// outside), its origin moved back so that the solid stays where it is.
+BinaryVolume padded(const BinaryVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
+  BinaryVolume p;
+  p.lattice = v.lattice;
+  for (size_t a = 0; a < 3; ++a) p.lattice.dims[a] = v.lattice.dims[a] + lo[a] + hi[a];
+  p.lattice.origin = v.lattice.to_physical(Vec3(-double(lo[0]), -double(lo[1]), -double(lo[2])));
+  p.inside.assign(p.lattice.size(), 0);
+  for (int64_t k = 0; k < v.lattice.dims[2]; ++k)
+    for (int64_t j = 0; j < v.lattice.dims[1]; ++j)
+      for (int64_t i = 0; i < v.lattice.dims[0]; ++i)
+        p.inside[p.lattice.linear(i + lo[0], j + lo[1], k + lo[2])] = v.inside[v.lattice.linear(i, j, k)];
+  p.source = v.source;
+  return p;
+}
+
+// The volume cropped to the box of its inside samples (negative padding).
+BinaryVolume cropped(const BinaryVolume& v) {
+  std::array<int64_t, 3> mn{INT64_MAX, INT64_MAX, INT64_MAX}, mx{-1, -1, -1};
+  for (int64_t k = 0; k < v.lattice.dims[2]; ++k)
+    for (int64_t j = 0; j < v.lattice.dims[1]; ++j)
+      for (int64_t i = 0; i < v.lattice.dims[0]; ++i)
+        if (v.inside[v.lattice.linear(i, j, k)]) {
+          const std::array<int64_t, 3> x{i, j, k};
+          for (size_t a = 0; a < 3; ++a) mn[a] = std::min(mn[a], x[a]), mx[a] = std::max(mx[a], x[a]);
+        }
+  BinaryVolume c;
+  c.lattice = v.lattice;
+  for (size_t a = 0; a < 3; ++a) c.lattice.dims[a] = mx[a] + 1 - mn[a];
+  c.lattice.origin = v.lattice.to_physical(Vec3(double(mn[0]), double(mn[1]), double(mn[2])));
+  c.inside.assign(c.lattice.size(), 0);
+  for (int64_t k = 0; k < c.lattice.dims[2]; ++k)
+    for (int64_t j = 0; j < c.lattice.dims[1]; ++j)
+      for (int64_t i = 0; i < c.lattice.dims[0]; ++i)
+        c.inside[c.lattice.linear(i, j, k)] = v.inside[v.lattice.linear(i + mn[0], j + mn[1], k + mn[2])];
+  c.source = v.source;
+  return c;
+}
+
+// The pressing stages that keep one vertex per stick (press, flats,
+// creases, quadric fit) on both volumes: the same sticks, shifted by the
+// same integers, and t within 1e-9 of each other.
+void expect_same_t(const BinaryVolume& a, const BinaryVolume& b, const SurfaceOptions& o) {
+  StickSurface sa = on_own_box(extract_sticks(a)), sb = on_own_box(extract_sticks(b));
+  ASSERT_EQ(sa.stick_count(), sb.stick_count());
+  ASSERT_GT(sa.stick_count(), 0u);
+  SurfaceResult ra, rb;
+  press_stick_surface(sa, o, ra);
+  press_stick_surface(sb, o, rb);
+  EXPECT_GT(ra.press.iterations, 0);
+  EXPECT_EQ(ra.flats.flats.size(), rb.flats.flats.size());
+  const auto la0 = sa.lower_index(0), lb0 = sb.lower_index(0);
+  double worst = 0;
+  size_t moved = 0;
+  for (size_t i = 0; i < sa.stick_count(); ++i) {
+    const auto la = sa.lower_index(i), lb = sb.lower_index(i);
+    for (size_t k = 0; k < 3; ++k) ASSERT_EQ(la[k] - la0[k], lb[k] - lb0[k]) << "stick " << i;
+    ASSERT_EQ(sa.axis(i), sb.axis(i));
+    worst = std::max(worst, std::abs(sa.t[i] - sb.t[i]));
+    moved += sa.t[i] != 0.5;
+  }
+  EXPECT_LE(worst, 1e-9);
+  EXPECT_GT(moved, sa.stick_count() / 2);  // the stages did run
+}
+
+TEST(Invariance, ShiftedAndPaddedRotatedShapesGiveTheSameT) {
+  for (const auto& [kind, seed] : {std::pair{ShapeKind::cad_part, 3}, std::pair{ShapeKind::sphere, 5},
+                                  std::pair{ShapeKind::box, 7}}) {
+    SCOPED_TRACE(std::string(shape_name(kind)) + " seed " + std::to_string(seed));
+    GenerateOptions g;
+    g.res = 48;
+    g.rotation = parse_rotation("random:" + std::to_string(seed));
+    const BinaryVolume v = generate_shape(kind, g).volume;
+    const BinaryVolume p = padded(v, {6, 7, 8}, {5, 5, 5});  // shifted by (1, 2, 3) and padded by 5
+    for (bool flats : {false, true}) {
+      SCOPED_TRACE(flats ? "default stages" : "--no-flats");
+      SurfaceOptions o;
+      if (!flats) o.passes.disable(Pass::flats);
+      expect_same_t(v, p, o);
+      expect_same_t(v, cropped(v), o);
+    }
+  }
+}
+
+TEST(Invariance, RealMaskShiftedPaddedAndCroppedGivesTheSameT) {
+  VOXPRESS_REQUIRE_SHARED_DATA();
+  const BinaryVolume v = binarize(read_volume(test::shared_data() + "/medical/totalseg_aorta.nii.gz"));
+  SurfaceOptions o;
+  expect_same_t(v, padded(v, {1, 2, 3}, {4, 0, 2}), o);
+  expect_same_t(v, cropped(v), o);
+}
+
+}  // namespace
+}  // namespace voxpress
