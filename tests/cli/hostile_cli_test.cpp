@@ -376,5 +376,25 @@ TEST(Hostile, EvalRefusesAnOpenTruthMesh) {
   EXPECT_EQ(test::run_cli("eval " + tmp.path("c.ply") + " --truth " + tmp.path("closed.obj"), &out), 0) << out;
 }
 
+// A zlib-compressed VTP block table declaring 2.4 GB in three blocks of a few
+// bytes each: the buffer was allocated and zeroed before the first block was
+// inflated (exit 3, bad_alloc under the address-space limit). Deflate expands
+// at most 1032:1, so 30 packed bytes are refused before anything is reserved.
+TEST(Hostile, VtpCompressedBlocksCannotDeclareMoreThanTheyHold) {
+  test::TempDir tmp;
+  const uint64_t points = 100'000'000, total = points * 3 * 8, size = uint64_t(1) << 30;
+  std::string table;
+  for (uint64_t v : {uint64_t(3), size, total - 2 * size, uint64_t(10), uint64_t(10), uint64_t(10)})
+    table += std::string(reinterpret_cast<const char*>(&v), 8);
+  test::write_file(tmp.path("big.vtp"),
+                   "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+                   "compressor=\"vtkZLibDataCompressor\"><PolyData><Piece NumberOfPoints=\"" + std::to_string(points) +
+                       "\" NumberOfPolys=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+                       "format=\"appended\" offset=\"0\"/></Points></Piece></PolyData>\n<AppendedData encoding=\"raw\">\n_" +
+                       table + std::string(30, 'x') + "\n</AppendedData></VTKFile>\n");
+  const test::CliRun r = test::run_cli_measured("--max-memory 8G check " + tmp.path("big.vtp"), kAddressSpace);
+  expect_refused(r, tmp.path("big.vtp"), "1032:1");
+}
+
 }  // namespace
 }  // namespace voxpress
