@@ -9,6 +9,7 @@
 #include <set>
 
 #include "voxpress/core/error.h"
+#include "voxpress/core/memory_budget.h"
 
 namespace voxpress::detail {
 namespace {
@@ -316,6 +317,12 @@ AtlasResult build_atlas(const Mesh& m, const AtlasOptions& options,
   Texture& tex = out.mesh.texture;
   tex.width = pk.width;
   tex.height = pk.height;
+  if (std::max(pk.width, pk.height) > options.max_side) return out;  // refused or retried by the caller
+  const uint64_t need = options.held_bytes + uint64_t(pk.width) * uint64_t(pk.height) * kVoxartBytesPerTexel;
+  if (options.max_bytes && need > options.max_bytes)
+    throw LimitError(options.source, "the texture atlas of " + std::to_string(pk.width) + " x " + std::to_string(pk.height) +
+                                         " texels needs, with the mesh, " + std::to_string(need >> 20) +
+                                         " MiB, above the memory limit of " + std::to_string(options.max_bytes >> 20) + " MiB");
   tex.rgba.assign(size_t(4 * tex.width * tex.height), 0);
   // Render each chart (in parallel: charts own disjoint rectangles), then
   // dilate its colours into its padding.

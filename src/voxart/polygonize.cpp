@@ -114,6 +114,16 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
     st.filled_cavities += quads.back().filled_cavities;
     st.separated_edges += quads.back().separated_edges;
   }
+  // Everything after the quads grows with them, the atlas with its texels:
+  // charged before any of it is made (issue 73, item 1).
+  uint64_t held = 0;
+  for (const ColorGrid& g : art.parts) held += uint64_t(g.dims[0] * g.dims[1] * g.dims[2]) * kVoxartBytesPerCell;
+  held += st.quads * kVoxartBytesPerQuad;
+  if (options.max_bytes && held > options.max_bytes)
+    throw LimitError(art.source, "its " + std::to_string(st.quads) + " voxel faces need about " +
+                                     std::to_string(held >> 20) + " MiB (" + std::to_string(kVoxartBytesPerQuad) +
+                                     " bytes each, with the grids), above the memory limit of " +
+                                     std::to_string(options.max_bytes >> 20) + " MiB");
   std::vector<Rgba> quad_color;
   std::vector<Vec3> quad_center;  // unfaired voxel face centres, model frame
   for (size_t p = 0; p < quads.size(); ++p) {
@@ -307,6 +317,10 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
       ao.texels_per_unit = k / voxel;
       ao.padding = options.padding;
       ao.packer = options.packer;
+      ao.max_side = options.max_texture;
+      ao.max_bytes = options.max_bytes;
+      ao.held_bytes = held;
+      ao.source = art.source;
       detail::AtlasResult a = detail::build_atlas(work, ao, face_color);
       const int64_t side = std::max(a.mesh.texture.width, a.mesh.texture.height);
       const bool too_big = side > options.max_texture;

@@ -1,0 +1,37 @@
+#pragma once
+// What --max-memory charges per unit of work, in one place (issue 73). Each
+// figure is the measured peak (`/usr/bin/time -f %M`, less the 14 MiB the
+// process holds before any work: `/usr/bin/time -f %M voxpress --version`)
+// over the units, rounded up; docs/RELIABILITY.md has the table.
+#include <cstdint>
+
+namespace voxpress {
+
+/// Voxel art, per cell of a part's grid: colours 4, the solid fill's masks and
+/// stack, the cuberille's padded masks and face slots (read_voxel_art).
+inline constexpr uint64_t kVoxartBytesPerCell = 16;
+/// Voxel art, per cuberille quad: the quad mesh, its triangles, fairing,
+/// the atlas's half-edges, neighbours and charts, the glTF buffers; 826 on
+/// menger.vox (`voxpress voxart menger.vox -o m.glb --stats-json s.json`).
+inline constexpr uint64_t kVoxartBytesPerQuad = 1024;
+/// Voxel art, per atlas texel: the RGBA texture and its PNG encoding.
+inline constexpr uint64_t kVoxartBytesPerTexel = 8;
+/// A voxelized or generated volume, per sample: the mask, its scalar copy for
+/// the writer and the compressed payload (`voxpress voxelize bunny.off --res 200`:
+/// 13.7 MiB for 6.25 M samples, 2.3 bytes).
+inline constexpr uint64_t kVolumeOutBytesPerSample = 3;
+/// render, per supersampled pixel: depth 4, colour 3 (`voxpress render
+/// armadillo.obj -o a.png`: 2400 x 1800 supersamples).
+inline constexpr uint64_t kRenderBytesPerSupersample = 7;
+/// render, per byte of a mesh file: what reading it charged (OBJ: 4) stays
+/// in the heap (`voxpress render armadillo.obj --size 200x150`: 16.3 MiB).
+inline constexpr uint64_t kRenderBytesPerMeshFileByte = 4;
+/// eval, per triangle of the result: its copy, BVH, area samples, distance and
+/// self-intersection work (`voxpress eval heart.ply --truth bunny.off`: 47 MiB
+/// for 76 914 faces, 610 a face; bunny.ply from `voxelize --res 200`: 470).
+inline constexpr uint64_t kEvalBytesPerResultFace = 640;
+/// A mesh in memory, per vertex (position 24, its projection or normal 24)
+/// and per triangle (12 and its per-face work 12).
+inline constexpr uint64_t kMeshBytesPerVertex = 48, kMeshBytesPerTriangle = 24;
+
+}  // namespace voxpress
