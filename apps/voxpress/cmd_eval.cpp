@@ -37,12 +37,9 @@ void run_eval(const EvalCmd& c, const Global& g) {
   // The result's measuring and the volume with its mask (memory_budget.h);
   // a truth mesh is charged when it is read.
   const uint64_t need = result.triangles.size() * kEvalBytesPerResultFace + (raw ? raw->bytes.size() + vol->inside.size() : 0);
-  if (const uint64_t cap = g.memory_limit(); cap && need > cap)
-    throw LimitError(c.result, "measuring it needs about " + std::to_string(need >> 20) + " MiB (" +
-                                   std::to_string(result.triangles.size()) + " faces, " +
-                                   std::to_string(kEvalBytesPerResultFace) +
-                                   " bytes each, with the volume), above the memory limit of " +
-                                   std::to_string(cap >> 20) + " MiB");
+  charge_memory(c.result, need, g.memory_limit(),
+                "measuring its " + std::to_string(result.triangles.size()) + " faces (" +
+                    std::to_string(kEvalBytesPerResultFace) + " bytes each, with the volume)");
   const auto truth = resolve_truth(c.truth, raw ? &*raw : nullptr);
   EvalOptions o;
   o.samples = c.samples;

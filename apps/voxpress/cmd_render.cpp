@@ -103,11 +103,9 @@ void run_render(const RenderCmd& c, const Global& g) {
       need += m.positions.size() * kMeshBytesPerVertex + m.triangles.size() * kMeshBytesPerTriangle +
               m.texture.rgba.size() + uint64_t(o.width) * uint64_t(o.height) *
                                           (uint64_t(o.supersample * o.supersample) * kRenderBytesPerSupersample + 4);
-    if (const uint64_t cap = g.memory_limit(); cap && need > cap)
-      throw LimitError(path, "reading and drawing it needs about " + std::to_string(need >> 20) + " MiB (the mesh and a " +
-                                 std::to_string(o.width) + " x " + std::to_string(o.height) +
-                                 " picture supersampled " + std::to_string(o.supersample) +
-                                 "x), above the memory limit of " + std::to_string(cap >> 20) + " MiB");
+    charge_memory(path, need, g.memory_limit(),
+                  "reading and drawing it (the mesh and a " + std::to_string(o.width) + " x " + std::to_string(o.height) +
+                      " picture supersampled " + std::to_string(o.supersample) + "x)");
   }
   // Several inputs share one scale: each picture frames every input's vertices.
   if (meshes.size() > 1)

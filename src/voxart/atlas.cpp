@@ -319,10 +319,8 @@ AtlasResult build_atlas(const Mesh& m, const AtlasOptions& options,
   tex.height = pk.height;
   if (std::max(pk.width, pk.height) > options.max_side) return out;  // refused or retried by the caller
   const uint64_t need = options.held_bytes + uint64_t(pk.width) * uint64_t(pk.height) * kVoxartBytesPerTexel;
-  if (options.max_bytes && need > options.max_bytes)
-    throw LimitError(options.source, "the texture atlas of " + std::to_string(pk.width) + " x " + std::to_string(pk.height) +
-                                         " texels needs, with the mesh, " + std::to_string(need >> 20) +
-                                         " MiB, above the memory limit of " + std::to_string(options.max_bytes >> 20) + " MiB");
+  charge_memory(options.source, need, options.max_bytes,
+                "the texture atlas of " + std::to_string(pk.width) + " x " + std::to_string(pk.height) + " texels, with the mesh,");
   tex.rgba.assign(size_t(4 * tex.width * tex.height), 0);
   // Render each chart (in parallel: charts own disjoint rectangles), then
   // dilate its colours into its padding.

@@ -118,12 +118,10 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
   // charged before any of it is made (issue 73, item 1).
   uint64_t held = 0;
   for (const ColorGrid& g : art.parts) held += uint64_t(g.dims[0] * g.dims[1] * g.dims[2]) * kVoxartBytesPerCell;
-  held += st.quads * kVoxartBytesPerQuad;
-  if (options.max_bytes && held > options.max_bytes)
-    throw LimitError(art.source, "its " + std::to_string(st.quads) + " voxel faces need about " +
-                                     std::to_string(held >> 20) + " MiB (" + std::to_string(kVoxartBytesPerQuad) +
-                                     " bytes each, with the grids), above the memory limit of " +
-                                     std::to_string(options.max_bytes >> 20) + " MiB");
+  held += st.quads * kVoxartBytesPerQuad + kVoxartBytesFixed;
+  charge_memory(art.source, held, options.max_bytes,
+                "its " + std::to_string(st.quads) + " voxel faces (" + std::to_string(kVoxartBytesPerQuad) +
+                    " bytes each, with the grids)");
   std::vector<Rgba> quad_color;
   std::vector<Vec3> quad_center;  // unfaired voxel face centres, model frame
   for (size_t p = 0; p < quads.size(); ++p) {

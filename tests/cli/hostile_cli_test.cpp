@@ -431,6 +431,29 @@ TEST(Hostile, MaxMemoryChargesWhatEachSubcommandHolds) {
                              kAddressSpace);
   expect_refused(r, tmp.path("solid.vox"), "9600 voxel faces");
   EXPECT_FALSE(fs::exists(tmp.path("s.png")));
+  // eval charged only the result file's reading (2 MiB here), not the
+  // measuring of its faces (640 bytes each) and the volume with its mask.
+  std::string out;
+  ASSERT_EQ(test::run_cli("-q generate sphere --res 64 -o " + tmp.path("s.nrrd"), &out), 0) << out;
+  ASSERT_EQ(test::run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("s.ply"), &out), 0) << out;
+  r = test::run_cli_measured("-q --max-memory 8M eval " + tmp.path("s.ply") + " --volume " + tmp.path("s.nrrd") +
+                                 " --json " + tmp.path("e.json"), kAddressSpace);
+  expect_refused(r, tmp.path("s.ply"), "640 bytes each");
+  EXPECT_FALSE(fs::exists(tmp.path("e.json")));
+  // press --labels charged the samples once on reading (256 KiB here) and
+  // 256 bytes per interface triangle, not the label view, masks and labels.
+  ScalarVolume map;
+  map.lattice.dims = {64, 64, 64};
+  map.type = ScalarType::u8;
+  map.bytes.assign(map.lattice.size(), std::byte{0});
+  for (int64_t k = 4; k < 12; ++k)
+    for (int64_t j = 4; j < 12; ++j)
+      for (int64_t i = 4; i < 12; ++i) map.bytes[map.lattice.linear(i, j, k)] = std::byte(i < 8 ? 7 : 9);
+  write_volume(tmp.path("map.nrrd"), map);
+  r = test::run_cli_measured("-q --max-memory 1M press " + tmp.path("map.nrrd") + " --labels all -o " + tmp.path("L"),
+                             kAddressSpace);
+  expect_refused(r, tmp.path("map.nrrd"), "the label map with its masks and 2 labels");
+  EXPECT_FALSE(fs::exists(tmp.path("L")));
 }
 
 }  // namespace

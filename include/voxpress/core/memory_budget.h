@@ -4,6 +4,7 @@
 // process holds before any work: `/usr/bin/time -f %M voxpress --version`)
 // over the units, rounded up; docs/RELIABILITY.md has the table.
 #include <cstdint>
+#include <string>
 
 namespace voxpress {
 
@@ -14,6 +15,9 @@ inline constexpr uint64_t kVoxartBytesPerCell = 16;
 /// the atlas's half-edges, neighbours and charts, the glTF buffers; 826 on
 /// menger.vox (`voxpress voxart menger.vox -o m.glb --stats-json s.json`).
 inline constexpr uint64_t kVoxartBytesPerQuad = 1024;
+/// Voxel art, once per run: the glTF writer and the thread pool's stacks
+/// (deer.vox: 2.4 MiB measured for 1.3 MiB of grid, faces and atlas).
+inline constexpr uint64_t kVoxartBytesFixed = 2 << 20;
 /// Voxel art, per atlas texel: the RGBA texture and its PNG encoding.
 inline constexpr uint64_t kVoxartBytesPerTexel = 8;
 /// A voxelized or generated volume, per sample: the mask, its scalar copy for
@@ -30,8 +34,21 @@ inline constexpr uint64_t kRenderBytesPerMeshFileByte = 4;
 /// self-intersection work (`voxpress eval heart.ply --truth bunny.off`: 47 MiB
 /// for 76 914 faces, 610 a face; bunny.ply from `voxelize --res 200`: 470).
 inline constexpr uint64_t kEvalBytesPerResultFace = 640;
+/// press --labels, per sample of a label map held in memory: the samples, the
+/// label view and masks (`voxpress press pyradiomics_brain1_label.nrrd --labels
+/// all -o L`: 13.9 MiB for 1.64 M samples and 10 188 interface triangles;
+/// pyradiomics_lung2_label.nrrd: 94 MiB for 16 M samples).
+inline constexpr uint64_t kLabelBytesPerSample = 8;
+/// press --labels, per label: its mesh, flats box mask and output
+/// (totalseg_example_seg_fast_force_split.nii.gz, 61 labels: 4.8 MiB above
+/// its samples and 256 bytes per interface triangle).
+inline constexpr uint64_t kLabelBytesPerLabel = 128 << 10;
 /// A mesh in memory, per vertex (position 24, its projection or normal 24)
 /// and per triangle (12 and its per-face work 12).
 inline constexpr uint64_t kMeshBytesPerVertex = 48, kMeshBytesPerTriangle = 24;
+
+/// Throws LimitError naming `path` when `bytes` exceed `cap` (0: no cap):
+/// "<what> needs N, above the memory limit of M" in MiB, KiB or bytes.
+void charge_memory(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);
 
 }  // namespace voxpress
