@@ -8,6 +8,11 @@
 
 namespace voxpress {
 
+/// Once per run that does work: the thread pool's stacks and the writer's
+/// buffers (`extract BallBinary30x30x30.nrrd` peaks 1.1 MiB above `--version`;
+/// `press totalseg_heart.nii.gz` 25.4 MiB above it for 23.9 charged without
+/// this; voxart deer.vox 2.4 MiB for 1.3).
+inline constexpr uint64_t kRunBytesFixed = 2 << 20;
 /// Voxel art, per cell of a part's grid: colours 4, the solid fill's masks and
 /// stack, the cuberille's padded masks and face slots (read_voxel_art).
 inline constexpr uint64_t kVoxartBytesPerCell = 16;
@@ -15,9 +20,6 @@ inline constexpr uint64_t kVoxartBytesPerCell = 16;
 /// the atlas's half-edges, neighbours and charts, the glTF buffers; 826 on
 /// menger.vox (`voxpress voxart menger.vox -o m.glb --stats-json s.json`).
 inline constexpr uint64_t kVoxartBytesPerQuad = 1024;
-/// Voxel art, once per run: the glTF writer and the thread pool's stacks
-/// (deer.vox: 2.4 MiB measured for 1.3 MiB of grid, faces and atlas).
-inline constexpr uint64_t kVoxartBytesFixed = 2 << 20;
 /// Voxel art, per atlas texel: the RGBA texture and its PNG encoding.
 inline constexpr uint64_t kVoxartBytesPerTexel = 8;
 /// A voxelized or generated volume, per sample: the mask, its scalar copy for
