@@ -440,6 +440,11 @@ TEST(Hostile, MaxMemoryChargesWhatEachSubcommandHolds) {
                                  " --json " + tmp.path("e.json"), kAddressSpace);
   expect_refused(r, tmp.path("s.ply"), "640 bytes each");
   EXPECT_FALSE(fs::exists(tmp.path("e.json")));
+  // press: 7.4 MiB charged for this sphere, 2 MiB a run short of what the
+  // process holds beyond its idle size (thread stacks, the writer).
+  r = test::run_cli_measured("-q --max-memory 8M press " + tmp.path("s.nrrd") + " -o " + tmp.path("p.ply"), kAddressSpace);
+  expect_refused(r, tmp.path("s.nrrd"), "the run 2048");
+  EXPECT_FALSE(fs::exists(tmp.path("p.ply")));
   // press --labels charged the samples once on reading (256 KiB here) and
   // 256 bytes per interface triangle, not the label view, masks and labels.
   ScalarVolume map;
