@@ -14,15 +14,17 @@ namespace voxpress {
 /// this; voxart deer.vox 2.4 MiB for 1.3).
 inline constexpr uint64_t kRunBytesFixed = 2 << 20;
 /// Voxel art, per cell of a part's grid: colours 4, the solid fill's masks and
-/// stack, the cuberille's padded masks and face slots (read_voxel_art).
+/// stack, the cuberille's padded masks and face slots (read_voxel_art;
+/// `voxpress voxart monu1.vox -o m.glb`: 80 x 80 x 115 cells).
 inline constexpr uint64_t kVoxartBytesPerCell = 16;
 /// Voxel art, per cuberille quad: the quad mesh, its triangles, fairing,
 /// the atlas's half-edges, neighbours and charts, the glTF buffers; 826 on
 /// menger.vox (`voxpress voxart menger.vox -o m.glb --stats-json s.json`).
 inline constexpr uint64_t kVoxartBytesPerQuad = 1024;
-/// Voxel art, per atlas texel: the RGBA texture and its PNG encoding.
+/// Voxel art, per atlas texel: the RGBA texture and its PNG encoding
+/// (`voxpress voxart dragon.vox -o d.glb`: a 2226 x 2575 atlas).
 inline constexpr uint64_t kVoxartBytesPerTexel = 8;
-/// A voxelized or generated volume, per sample: the mask, its scalar copy for
+/// A voxelized or generated (`voxpress generate`) volume, per sample: the mask, its scalar copy for
 /// the writer and the compressed payload (`voxpress voxelize bunny.off --res 200`:
 /// 13.7 MiB for 6.25 M samples, 2.3 bytes).
 inline constexpr uint64_t kVolumeOutBytesPerSample = 3;
@@ -46,7 +48,8 @@ inline constexpr uint64_t kLabelBytesPerSample = 8;
 /// its samples and 256 bytes per interface triangle).
 inline constexpr uint64_t kLabelBytesPerLabel = 128 << 10;
 /// A mesh in memory, per vertex (position 24, its projection or normal 24)
-/// and per triangle (12 and its per-face work 12).
+/// and per triangle (12 and its per-face work 12), as render holds them
+/// (`voxpress render armadillo.obj -o a.png`: 43 243 vertices, 86 482 faces).
 inline constexpr uint64_t kMeshBytesPerVertex = 48, kMeshBytesPerTriangle = 24;
 
 /// Throws LimitError naming `path` when `bytes` exceed `cap` (0: no cap):
