@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "common.h"
+#include "voxpress/core/memory_budget.h"
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
 
@@ -33,6 +34,12 @@ void run_eval(const EvalCmd& c, const Global& g) {
     raw = load_volume(c.volume, c.in, g);
     vol = binarize(*raw, c.in.selection());
   }
+  // The result's measuring and the volume with its mask (memory_budget.h);
+  // a truth mesh is charged when it is read.
+  const uint64_t need = result.triangles.size() * kEvalBytesPerResultFace + (raw ? raw->bytes.size() + vol->inside.size() : 0);
+  charge_memory(c.result, need, g.memory_limit(),
+                "measuring its " + std::to_string(result.triangles.size()) + " faces (" +
+                    std::to_string(kEvalBytesPerResultFace) + " bytes each, with the volume)");
   const auto truth = resolve_truth(c.truth, raw ? &*raw : nullptr);
   EvalOptions o;
   o.samples = c.samples;

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "common.h"
+#include "voxpress/core/memory_budget.h"
 
 namespace voxpress::cli {
 namespace {
@@ -183,6 +184,19 @@ LabelSource open_labels(const std::string& input, const InputOptions& in, const 
 
 }  // namespace
 
+// The label map in memory, its masks and each label's meshes and flats stay
+// while the labels are pressed (memory_budget.h): charged here, and the
+// presses are given what is left (the shared one charges 256 bytes per
+// interface triangle). --chunk streams the map: nothing is held.
+uint64_t charge_label_map(const LabelSource& src, size_t labels, const std::string& input, SurfaceOptions& so) {
+  if (!src.volume) return 0;
+  const uint64_t held = src.volume->lattice.size() * kLabelBytesPerSample + labels * kLabelBytesPerLabel;
+  charge_memory(input, held, so.extract.max_bytes,
+                "the label map with its masks and " + std::to_string(labels) + " labels");
+  if (so.extract.max_bytes) so.extract.max_bytes -= held;
+  return held;
+}
+
 void run_press_labels(const std::string& input, const InputOptions& in, const SurfaceOptions& options,
                       const LabelOutput& o, const Global& g) {
   namespace fs = std::filesystem;
@@ -204,22 +218,29 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
   const double seconds_read = clock.seconds();
   SurfaceOptions so = options;
   so.progress = bar.get();
+  const uint64_t held = charge_label_map(src, chosen.size(), input, so);
   // Layers of a .seg.nrrd overlap: each is meshed alone, as are the baselines.
   const bool shared = !o.separate && !table.layered && so.method == Method::pressing;
   const bool strict = keeps_classification(so.method);
   Mesh combined;
   nlohmann::json shared_stats;
   std::vector<LabelPiece> pieces;
-  if (shared) {
-    SharedLabels r = src.surface ? press_shared_labels(std::move(*src.surface), src.masks, table, so, input)
-                                 : press_shared_labels(*src.volume, table, so);
-    if (src.surface) r.seconds_extract = src.seconds_extract;
-    shared_stats = shared_json(r);
-    pieces = shared_pieces(r, chosen);
-    combined = interfaces_mesh(r.surface);
-  } else {
-    for (LabelSurface& s : press_labels(*src.volume, chosen, so))
-      pieces.push_back({s.label, std::move(s.result.mesh), s.result.flats.flats.size()});
+  try {
+    if (shared) {
+      SharedLabels r = src.surface ? press_shared_labels(std::move(*src.surface), src.masks, table, so, input)
+                                   : press_shared_labels(*src.volume, table, so);
+      if (src.surface) r.seconds_extract = src.seconds_extract;
+      shared_stats = shared_json(r);
+      pieces = shared_pieces(r, chosen);
+      combined = interfaces_mesh(r.surface);
+    } else {
+      for (LabelSurface& s : press_labels(*src.volume, chosen, so))
+        pieces.push_back({s.label, std::move(s.result.mesh), s.result.flats.flats.size()});
+    }
+  } catch (const LimitError& e) {
+    if (!held) throw;
+    throw LimitError(e.path(), e.problem() + " left after the " + std::to_string(held >> 20) +
+                                   " MiB the label map and its labels hold");
   }
 
   // File names: the label's name when it has one and no other label shares it.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common.h"
+#include "voxpress/core/memory_budget.h"
 #include "voxpress/render/render.h"
 
 namespace voxpress::cli {
@@ -72,6 +73,7 @@ void run_render(const RenderCmd& c, const Global& g) {
                      std::to_string(c.inputs.size()) + " inputs (give one, or one per input)");
   std::vector<Mesh> meshes;
   std::vector<Texture> pictures;
+  uint64_t read_residue = 0;
   for (size_t i = 0; i < c.inputs.size(); ++i) {
     const std::string& path = c.inputs[i];
     const std::string method = methods.empty() ? "" : methods.size() == 1 ? methods[0] : methods[i];
@@ -85,6 +87,7 @@ void run_render(const RenderCmd& c, const Global& g) {
       ro.max_bytes = g.memory_limit();
       VoxartOptions vo;
       vo.y_up = false;  // the render camera is Z-up
+      vo.max_bytes = g.memory_limit();
       vo.fairing = parse_voxart_fairing(method.empty() ? "lanczos" : method == "voxels" ? "none" : method);
       mesh = polygonize_voxel_art(read_voxel_art(path, ro), vo).mesh;
     } else {
@@ -92,6 +95,17 @@ void run_render(const RenderCmd& c, const Global& g) {
     }
     if (mesh.triangles.empty()) throw InputError(path, "has no triangles to draw");
     meshes.push_back(std::move(mesh));
+    // The meshes so far and one supersampled picture each (memory_budget.h);
+    // a mesh file's parse stays in the heap while the pictures are drawn.
+    if (is_mesh_path(path)) read_residue += std::filesystem::file_size(path) * kRenderBytesPerMeshFileByte;
+    uint64_t need = read_residue;
+    for (const Mesh& m : meshes)
+      need += m.positions.size() * kMeshBytesPerVertex + m.triangles.size() * kMeshBytesPerTriangle +
+              m.texture.rgba.size() + uint64_t(o.width) * uint64_t(o.height) *
+                                          (uint64_t(o.supersample * o.supersample) * kRenderBytesPerSupersample + 4);
+    charge_memory(path, need, g.memory_limit(),
+                  "reading and drawing it (the mesh and a " + std::to_string(o.width) + " x " + std::to_string(o.height) +
+                      " picture supersampled " + std::to_string(o.supersample) + "x)");
   }
   // Several inputs share one scale: each picture frames every input's vertices.
   if (meshes.size() > 1)

@@ -24,6 +24,7 @@ void run_voxart(VoxartCmd c, const Global& g) {
   c.options.packer = parse_atlas_packer(c.packer);
   c.options.texture = !c.no_texture;
   c.options.y_up = !c.z_up;
+  c.options.max_bytes = g.memory_limit();
   Stopwatch clock;
   VoxelArtReadOptions ro;
   ro.max_bytes = g.memory_limit();

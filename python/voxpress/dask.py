@@ -122,6 +122,13 @@ def _label_block(samples, **kw):
     return _voxpress._label_block(np.asarray(samples), **kw)
 
 
+def _labels_arg(labels):
+    # None and a string go to press_labels's own reading ("all" as on the
+    # command line, another string a UsageError); list("all") split it into
+    # characters (issue 73).
+    return labels if labels is None or isinstance(labels, str) else list(labels)
+
+
 def press_labels(array, labels=None, *, chunk=256, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
                  client=None, threads=0, interfaces=False, **options):
     """Every label of a label map, block by block on Dask: voxpress.press_labels's result, byte for byte.
@@ -164,6 +171,6 @@ def press_labels(array, labels=None, *, chunk=256, spacing=(1.0, 1.0, 1.0), orig
 
     if "disable_passes" in options and options["disable_passes"] is not None:
         options["disable_passes"] = list(options["disable_passes"])
-    return _voxpress._press_label_blocks(parts, shape=shape, labels=None if labels is None else list(labels), read=read,
+    return _voxpress._press_label_blocks(parts, shape=shape, labels=_labels_arg(labels), read=read,
                                          spacing=spacing, origin=origin, direction=direction, interfaces=interfaces,
                                          **{k: v for k, v in options.items() if v is not None})

@@ -7,12 +7,13 @@
 
 #include "row_rays.h"
 #include "voxpress/core/error.h"
+#include "voxpress/core/memory_budget.h"
 #include "voxpress/eval/checks.h"
 
 namespace voxpress {
 
 Placement place_on_lattice(const Vec3& lo, const Vec3& hi, const Mat3& rotation, int64_t res, const Vec3& spacing,
-                           int64_t margin, uint64_t max_bytes) {
+                           int64_t margin, uint64_t max_bytes, const std::string& source) {
   if (res < 8) throw UsageError("--res must be at least 8");
   if (res > (int64_t(1) << 20)) throw UsageError("--res is absurdly large");
   if (margin < 0 || margin > res / 4) throw UsageError("--margin must be between 0 and res/4");
@@ -30,9 +31,11 @@ Placement place_on_lattice(const Vec3& lo, const Vec3& hi, const Mat3& rotation,
   }
   p.lattice.spacing = spacing;
   p.lattice.validate();
-  if (max_bytes && p.lattice.size() > max_bytes)
-    throw LimitError("", "a " + std::to_string(p.lattice.dims[0]) + "x" + std::to_string(p.lattice.dims[1]) + "x" +
-                             std::to_string(p.lattice.dims[2]) + " volume exceeds the memory limit");
+  // The mask, its scalar copy and the written payload (memory_budget.h).
+  if (max_bytes && p.lattice.size() > max_bytes / kVolumeOutBytesPerSample)
+    throw LimitError(source, "a " + std::to_string(p.lattice.dims[0]) + "x" + std::to_string(p.lattice.dims[1]) + "x" +
+                             std::to_string(p.lattice.dims[2]) + " volume (" + std::to_string(kVolumeOutBytesPerSample) +
+                             " bytes a sample) exceeds the memory limit");
   p.linear = p.scale * rotation;
   const Vec3 centre = 0.5 * Vec3(double(p.lattice.dims[0] - 1), double(p.lattice.dims[1] - 1),
                                  double(p.lattice.dims[2] - 1)).cwiseProduct(spacing);
@@ -89,7 +92,7 @@ Voxelized voxelize(const Mesh& model, const VoxelizeOptions& o, const std::strin
     hi = hi.cwiseMax(q);
   }
   Voxelized v;
-  v.placement = place_on_lattice(lo, hi, o.rotation, o.res, o.spacing, o.margin, o.max_bytes);
+  v.placement = place_on_lattice(lo, hi, o.rotation, o.res, o.spacing, o.margin, o.max_bytes, source);
   Mesh physical;
   physical.positions.reserve(model.positions.size());
   for (const Vec3& p : model.positions) physical.positions.push_back(v.placement.translation + v.placement.linear * p);

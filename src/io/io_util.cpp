@@ -1,5 +1,7 @@
 #include "io_util.h"
 
+#include "voxpress/core/memory_budget.h"
+
 #include "voxpress/io/atomic_file.h"
 
 #include <signal.h>
@@ -448,4 +450,8 @@ void remove_temporaries_on_signals() {
     ::sigaction(sig, &sa, nullptr);
   }
 }
+void charge_memory(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what) {
+  detail::check_limit(path, bytes, cap, what);
+}
+
 }  // namespace voxpress

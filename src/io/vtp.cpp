@@ -46,6 +46,8 @@ class Source {
     }
     return out;
   }
+  // At most the bytes left (base64: an upper bound before whitespace).
+  uint64_t most_left() const { return b64_ ? 3 * (s_.size() / 4) + 3 : s_.size(); }
 
  private:
   void quartet() {
@@ -172,13 +174,23 @@ class Reader {
     const uint64_t total = blocks == 0 ? 0 : (blocks - 1) * size + (last ? last : size);
     check_limit(path_, total, cap_, "a compressed DataArray");
     const std::vector<std::byte> sizes = src.take(blocks * hs);
-    std::vector<std::byte> out(total);
-    uint64_t at = 0;
+    // The packed blocks must be in the file and able to inflate to the
+    // declared total (deflate: at most kMaxDeflateRatio:1) before anything is
+    // reserved; the output grows as each block is inflated (issue 73: a
+    // 100-byte file declaring 2.4 GB was allocated, and zeroed, up front).
+    uint64_t packed_total = 0;
+    for (uint64_t b = 0; b < blocks; ++b) {
+      packed_total += header_value(sizes, b);
+      if (packed_total > src.most_left()) throw InputError(path_, "truncated DataArray data");
+    }
+    check_ratio(path_, size_t(packed_total), total);
+    std::vector<std::byte> out;
+    out.reserve(total);
     for (uint64_t b = 0; b < blocks; ++b) {
       const std::vector<std::byte> packed = src.take(header_value(sizes, b));
       const uint64_t want = b + 1 == blocks && last ? last : size;
-      inflate_exact(path_, packed.data(), packed.size(), out.data() + at, want);
-      at += want;
+      out.resize(out.size() + want);
+      inflate_exact(path_, packed.data(), packed.size(), out.data() + out.size() - want, want);
     }
     return out;
   }

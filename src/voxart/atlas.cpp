@@ -9,6 +9,7 @@
 #include <set>
 
 #include "voxpress/core/error.h"
+#include "voxpress/core/memory_budget.h"
 
 namespace voxpress::detail {
 namespace {
@@ -214,6 +215,18 @@ Rgba sample_texture(const Texture& t, const Vec2& uv) {
   return {t.rgba[o], t.rgba[o + 1], t.rgba[o + 2], t.rgba[o + 3]};
 }
 
+namespace {
+
+// The texture and its encoding, with what the caller holds, before it is made.
+void charge_texture(const Packing& pk, const AtlasOptions& options) {
+  const uint64_t need = options.held_bytes + uint64_t(pk.width) * uint64_t(pk.height) * kVoxartBytesPerTexel;
+  charge_memory(options.source, need, options.max_bytes,
+                "the texture atlas of " + std::to_string(pk.width) + " x " + std::to_string(pk.height) +
+                    " texels, with the mesh,");
+}
+
+}  // namespace
+
 AtlasResult build_atlas(const Mesh& m, const AtlasOptions& options,
                         const std::function<Rgba(uint32_t, const Vec3&)>& color) {
   const size_t nf = m.triangles.size();
@@ -316,6 +329,8 @@ AtlasResult build_atlas(const Mesh& m, const AtlasOptions& options,
   Texture& tex = out.mesh.texture;
   tex.width = pk.width;
   tex.height = pk.height;
+  if (std::max(pk.width, pk.height) > options.max_side) return out;  // refused or retried by the caller
+  charge_texture(pk, options);
   tex.rgba.assign(size_t(4 * tex.width * tex.height), 0);
   // Render each chart (in parallel: charts own disjoint rectangles), then
   // dilate its colours into its padding.

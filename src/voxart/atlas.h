@@ -28,6 +28,9 @@ struct AtlasOptions {
   double texels_per_unit = 4;  ///< texels per unit of the mesh's coordinates
   int padding = 2;
   AtlasPacker packer = AtlasPacker::best;
+  int64_t max_side = int64_t(1) << 62;  ///< wider: only the size is returned, no texture made
+  uint64_t max_bytes = 0, held_bytes = 0;  ///< the memory cap (0: none) and what the caller holds
+  std::string source;                      ///< named by a refusal
 };
 
 struct AtlasResult {

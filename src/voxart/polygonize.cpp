@@ -89,6 +89,22 @@ Mesh VoxartResult::surface() const {
   return s;
 }
 
+namespace {
+
+// Everything after the quads grows with them (the atlas with its texels,
+// charged once packed): charged before any of it is made (issue 73, item 1).
+// Returns the bytes held: the grids, the quads' share and the run's.
+uint64_t charge_quads(const VoxelArt& art, uint64_t quads, uint64_t cap) {
+  uint64_t held = quads * kVoxartBytesPerQuad + kRunBytesFixed;
+  for (const ColorGrid& g : art.parts) held += uint64_t(g.dims[0] * g.dims[1] * g.dims[2]) * kVoxartBytesPerCell;
+  charge_memory(art.source, held, cap,
+                "its " + std::to_string(quads) + " voxel faces (" + std::to_string(kVoxartBytesPerQuad) +
+                    " bytes each, with the grids)");
+  return held;
+}
+
+}  // namespace
+
 VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& options) {
   const auto t_start = Clock::now();
   VoxartResult result;
@@ -114,6 +130,7 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
     st.filled_cavities += quads.back().filled_cavities;
     st.separated_edges += quads.back().separated_edges;
   }
+  const uint64_t held = charge_quads(art, st.quads, options.max_bytes);
   std::vector<Rgba> quad_color;
   std::vector<Vec3> quad_center;  // unfaired voxel face centres, model frame
   for (size_t p = 0; p < quads.size(); ++p) {
@@ -307,6 +324,10 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
       ao.texels_per_unit = k / voxel;
       ao.padding = options.padding;
       ao.packer = options.packer;
+      ao.max_side = options.max_texture;
+      ao.max_bytes = options.max_bytes;
+      ao.held_bytes = held;
+      ao.source = art.source;
       detail::AtlasResult a = detail::build_atlas(work, ao, face_color);
       const int64_t side = std::max(a.mesh.texture.width, a.mesh.texture.height);
       const bool too_big = side > options.max_texture;

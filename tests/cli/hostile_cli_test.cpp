@@ -376,5 +376,90 @@ TEST(Hostile, EvalRefusesAnOpenTruthMesh) {
   EXPECT_EQ(test::run_cli("eval " + tmp.path("c.ply") + " --truth " + tmp.path("closed.obj"), &out), 0) << out;
 }
 
+// A zlib-compressed VTP block table declaring 2.4 GB in three blocks of a few
+// bytes each: the buffer was allocated and zeroed before the first block was
+// inflated (exit 3, bad_alloc under the address-space limit). Deflate expands
+// at most 1032:1, so 30 packed bytes are refused before anything is reserved.
+TEST(Hostile, VtpCompressedBlocksCannotDeclareMoreThanTheyHold) {
+  test::TempDir tmp;
+  const uint64_t points = 100'000'000, total = points * 3 * 8, size = uint64_t(1) << 30;
+  std::string table;
+  for (uint64_t v : {uint64_t(3), size, total - 2 * size, uint64_t(10), uint64_t(10), uint64_t(10)})
+    table += std::string(reinterpret_cast<const char*>(&v), 8);
+  test::write_file(tmp.path("big.vtp"),
+                   "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+                   "compressor=\"vtkZLibDataCompressor\"><PolyData><Piece NumberOfPoints=\"" + std::to_string(points) +
+                       "\" NumberOfPolys=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+                       "format=\"appended\" offset=\"0\"/></Points></Piece></PolyData>\n<AppendedData encoding=\"raw\">\n_" +
+                       table + std::string(30, 'x') + "\n</AppendedData></VTKFile>\n");
+  const test::CliRun r = test::run_cli_measured("--max-memory 8G check " + tmp.path("big.vtp"), kAddressSpace);
+  expect_refused(r, tmp.path("big.vtp"), "1032:1");
+}
+
+// --max-memory charged only part of what voxelize, render and voxart hold
+// (issue 73, Must show): voxelize the mask alone (measured: 2.3 bytes a
+// sample), render not its supersampled picture (30 MB at 800 x 600), voxart
+// the grid but not its faces (34 MiB measured on monu1.vox for an 11 MiB
+// estimate). Each limit here was accepted before; each run is now refused
+// naming its input, with nothing written (memory_budget.h).
+TEST(Hostile, MaxMemoryChargesWhatEachSubcommandHolds) {
+  test::TempDir tmp;
+  test::write_file(tmp.path("box.off"), "OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                                        "3 0 2 1\n3 0 3 2\n3 4 5 6\n3 4 6 7\n3 0 1 5\n3 0 5 4\n"
+                                        "3 1 2 6\n3 1 6 5\n3 2 3 7\n3 2 7 6\n3 3 0 4\n3 3 4 7\n");
+  // 200³ samples: 8 MB of mask, 24 MB charged.
+  test::CliRun r = test::run_cli_measured("-q --max-memory 12M voxelize " + tmp.path("box.off") + " --res 200 -o " +
+                                              tmp.path("box.nrrd"), kAddressSpace);
+  expect_refused(r, tmp.path("box.off"), "3 bytes a sample");
+  EXPECT_FALSE(fs::exists(tmp.path("box.nrrd")));
+  // 800 x 600 supersampled 3x: 2400 x 1800 depths and colours.
+  r = test::run_cli_measured("-q --max-memory 20M render " + tmp.path("box.off") + " -o " + tmp.path("box.png"),
+                             kAddressSpace);
+  expect_refused(r, tmp.path("box.off"), "supersampled 3x");
+  EXPECT_FALSE(fs::exists(tmp.path("box.png")));
+  // A 40³ solid: a 1 MiB grid, 9600 voxel faces.
+  std::vector<std::array<uint8_t, 4>> voxels;
+  for (uint8_t k = 0; k < 40; ++k)
+    for (uint8_t j = 0; j < 40; ++j)
+      for (uint8_t i = 0; i < 40; ++i) voxels.push_back({i, j, k, uint8_t(1 + (i + j + k) % 7)});
+  test::write_file(tmp.path("solid.vox"), test::vox_file(test::vox_model({40, 40, 40}, voxels)));
+  r = test::run_cli_measured("-q --max-memory 6M voxart " + tmp.path("solid.vox") + " -o " + tmp.path("s.glb"),
+                             kAddressSpace);
+  expect_refused(r, tmp.path("solid.vox"), "9600 voxel faces");
+  EXPECT_FALSE(fs::exists(tmp.path("s.glb")));
+  r = test::run_cli_measured("-q --max-memory 6M render " + tmp.path("solid.vox") + " -o " + tmp.path("s.png"),
+                             kAddressSpace);
+  expect_refused(r, tmp.path("solid.vox"), "9600 voxel faces");
+  EXPECT_FALSE(fs::exists(tmp.path("s.png")));
+  // eval charged only the result file's reading (2 MiB here), not the
+  // measuring of its faces (640 bytes each) and the volume with its mask.
+  std::string out;
+  ASSERT_EQ(test::run_cli("-q generate sphere --res 64 -o " + tmp.path("s.nrrd"), &out), 0) << out;
+  ASSERT_EQ(test::run_cli("-q press " + tmp.path("s.nrrd") + " -o " + tmp.path("s.ply"), &out), 0) << out;
+  r = test::run_cli_measured("-q --max-memory 8M eval " + tmp.path("s.ply") + " --volume " + tmp.path("s.nrrd") +
+                                 " --json " + tmp.path("e.json"), kAddressSpace);
+  expect_refused(r, tmp.path("s.ply"), "640 bytes each");
+  EXPECT_FALSE(fs::exists(tmp.path("e.json")));
+  // press: 7.4 MiB charged for this sphere, 2 MiB a run short of what the
+  // process holds beyond its idle size (thread stacks, the writer).
+  r = test::run_cli_measured("-q --max-memory 8M press " + tmp.path("s.nrrd") + " -o " + tmp.path("p.ply"), kAddressSpace);
+  expect_refused(r, tmp.path("s.nrrd"), "the run 2048");
+  EXPECT_FALSE(fs::exists(tmp.path("p.ply")));
+  // press --labels charged the samples once on reading (256 KiB here) and
+  // 256 bytes per interface triangle, not the label view, masks and labels.
+  ScalarVolume map;
+  map.lattice.dims = {64, 64, 64};
+  map.type = ScalarType::u8;
+  map.bytes.assign(map.lattice.size(), std::byte{0});
+  for (int64_t k = 4; k < 12; ++k)
+    for (int64_t j = 4; j < 12; ++j)
+      for (int64_t i = 4; i < 12; ++i) map.bytes[map.lattice.linear(i, j, k)] = std::byte(i < 8 ? 7 : 9);
+  write_volume(tmp.path("map.nrrd"), map);
+  r = test::run_cli_measured("-q --max-memory 1M press " + tmp.path("map.nrrd") + " --labels all -o " + tmp.path("L"),
+                             kAddressSpace);
+  expect_refused(r, tmp.path("map.nrrd"), "the label map with its masks and 2 labels");
+  EXPECT_FALSE(fs::exists(tmp.path("L")));
+}
+
 }  // namespace
 }  // namespace voxpress

@@ -140,3 +140,20 @@ def test_dask_label_maps_give_press_labels_bytes():
         voxpress.dask.press_labels(np.zeros((20, 20, 20), np.uint8), chunk=8)
     with pytest.raises(voxpress.InputError):
         voxpress.dask.press_labels(vol, labels=[7], chunk=32)
+
+
+def test_dask_press_labels_takes_all_as_press_labels_does():
+    # issue 73: labels="all" was split into the characters 'a', 'l', 'l'.
+    pytest.importorskip("dask")
+    import voxpress.dask
+
+    vol = np.zeros((12, 12, 12), np.uint16)
+    vol[2:10, 2:10, 2:6] = 7
+    vol[2:10, 2:10, 6:10] = 300
+    every = voxpress.dask.press_labels(vol, labels="all", chunk=8, flats=False)
+    assert sorted(every) == [7, 300]
+    ref = voxpress.press_labels(vol, flats=False)
+    for label, mesh in ref.items():
+        np.testing.assert_array_equal(every[label].faces, mesh.faces)
+    with pytest.raises(voxpress.UsageError, match="labels="):
+        voxpress.dask.press_labels(vol, labels="7,300", chunk=8)

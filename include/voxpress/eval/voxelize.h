@@ -27,10 +27,10 @@ struct Placement {
 /// Lattice for a model whose rotated bounding box is [lo, hi] (model units,
 /// after rotation): `res` samples along the physically longest side, `margin`
 /// outside samples on every side, cells of `spacing`, the box centred.
-/// Throws UsageError for res < 8 or a bad margin/spacing, LimitError when the
-/// sample count exceeds max_bytes (0 = no cap).
+/// Throws UsageError for res < 8 or a bad margin/spacing, LimitError naming
+/// `source` when kVolumeOutBytesPerSample per sample exceeds max_bytes (0 = no cap).
 Placement place_on_lattice(const Vec3& lo, const Vec3& hi, const Mat3& rotation, int64_t res, const Vec3& spacing,
-                           int64_t margin, uint64_t max_bytes);
+                           int64_t margin, uint64_t max_bytes, const std::string& source = "");
 
 struct VoxelizeOptions {
   int64_t res = 128;

@@ -78,6 +78,7 @@ struct VoxartOptions {
   int padding = 2;              ///< texels of dilated border around each chart
   AtlasPacker packer = AtlasPacker::best;
   bool y_up = true;             ///< rotate the Z-up voxel frame to glTF's Y-up
+  uint64_t max_bytes = 0;       ///< memory cap for the grids, quads and atlas (memory_budget.h); 0 = none
 };
 
 struct VoxartStats {

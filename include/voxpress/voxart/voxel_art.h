@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "voxpress/core/types.h"
+#include "voxpress/core/memory_budget.h"
 
 namespace voxpress {
 
@@ -51,11 +52,6 @@ struct VoxelArt {
   uint64_t voxel_count() const;
 };
 
-/// Bytes the voxel-art pipeline holds per cell of a part's grid at its peak
-/// (the grid's colours 4, the solid fill's outside mask, its flood-fill stack
-/// and solid mask, the cuberille's padded masks and face slots): what
-/// read_voxel_art charges to the memory cap before allocating a grid.
-inline constexpr uint64_t kVoxartBytesPerCell = 16;
 
 struct VoxelArtReadOptions {
   uint64_t max_bytes = 0;  ///< memory cap; 0 = default_memory_limit()
