@@ -216,7 +216,7 @@ nlohmann::json smooth_stats_json(const SmoothStats& st) {
 
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
   return {{"iterations", st.iterations},    {"max_iterations", o.iterations},
-          {"residual", st.residual}, {"warm_sweeps", st.warm_sweeps}, {"restarts", st.restarts}, {"tolerance", o.tolerance}, {"curves", st.curves},
+          {"residual", st.residual}, {"tolerance", o.tolerance}, {"curves", st.curves},
           {"fresh", st.fresh},              {"frozen", st.frozen},
           {"seconds", st.seconds},          {"levels", st.levels},
           {"momentum", o.momentum},         {"arc_length", o.arc_length},

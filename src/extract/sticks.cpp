@@ -23,7 +23,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <chrono>
@@ -133,41 +132,6 @@ std::array<int64_t, 3> StickSurface::lower_index(size_t s) const {
   const uint64_t l = lower[s];
   const uint64_t px = uint64_t(padded[0]), py = uint64_t(padded[1]);
   return {int64_t(l % px) - 1, int64_t((l / px) % py) - 1, int64_t(l / (px * py)) - 1};
-}
-
-StickSurface on_own_box(StickSurface s) {
-  const size_t n = s.stick_count();
-  if (n == 0) return s;
-  using Bounds = std::array<int64_t, 6>;  // min, then max, of each coordinate
-  const Bounds box = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, n, 1 << 14), Bounds{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MIN, INT64_MIN, INT64_MIN},
-      [&](const tbb::blocked_range<size_t>& r, Bounds b) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-          const auto l = s.lower_index(i);
-          for (size_t a = 0; a < 3; ++a) b[a] = std::min(b[a], l[a]), b[a + 3] = std::max(b[a + 3], l[a]);
-        }
-        return b;
-      },
-      [](Bounds x, const Bounds& y) {
-        for (size_t a = 0; a < 3; ++a) x[a] = std::min(x[a], y[a]), x[a + 3] = std::max(x[a + 3], y[a + 3]);
-        return x;
-      });
-  const std::array<int64_t, 3> old_padded = s.padded;
-  const Vec3 lo{double(box[0]), double(box[1]), double(box[2])};
-  s.lattice.origin = s.lattice.to_physical(lo);
-  for (size_t a = 0; a < 3; ++a) {
-    s.lattice.dims[a] = box[a + 3] + 2 - box[a];  // a stick's upper sample lies one past its lower one
-    s.padded[a] = s.lattice.dims[a] + 2;
-  }
-  const uint64_t ox = uint64_t(old_padded[0]), oy = uint64_t(old_padded[1]);
-  const uint64_t px = uint64_t(s.padded[0]), py = uint64_t(s.padded[1]);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) {
-    const uint64_t l = s.lower[i];
-    const uint64_t x = l % ox - uint64_t(box[0] + 1), y = (l / ox) % oy - uint64_t(box[1] + 1),
-                   z = l / (ox * oy) - uint64_t(box[2] + 1);
-    s.lower[i] = (x + 1) + px * ((y + 1) + py * (z + 1));
-  });
-  return s;
 }
 
 Vec3 StickSurface::index_position(size_t s) const {

@@ -39,16 +39,15 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const auto t0 = std::chrono::steady_clock::now();
   StickSurface est = s;
   PressOptions eo = po;
-  // The estimates are the same solve to a coarse tolerance (the normals the
-  // votes need settle long before the fixed point), fixed so that the flats
-  // do not depend on po.tolerance, nor on po.levels: the detection's
-  // thresholds were tuned on 2 stages (with 3, a face can gain a piece of a
-  // few hundred sticks, degrees off it, that no plane merges back).
-  eo.tolerance = detail::kEstimateTolerance;
+  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
+  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
+  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
+  // that no plane merges back).
   eo.levels = 2;
+  eo.tolerance = 0;
   eo.progress = nullptr;
   eo.free_ends = false;  // see PressOptions::free_ends
-  press(est, curves, eo);
+  const PressStats first_estimate = press(est, curves, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
   // piece of a face (a couple of degrees off) can change the second
@@ -67,11 +66,12 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
     return frozen;
   };
+  bool est_is_plain = true;  // est is still the plain press of s (no pass froze flats in it)
   for (int pass = 1; pass < detail::kDetectionPasses && !seg.flats.empty(); ++pass) {
+    est_is_plain = false;
     const auto t1 = std::chrono::steady_clock::now();
-    // From the last estimate, the new flats on their planes.
-    for (size_t v = 0; v < s.stick_count(); ++v)
-      if (seg.region[v] >= 0) est.t[v] = s.lower_inside(v) ? seg.t[v] : 1 - seg.t[v];
+    est = s;
+    apply_flats(est, seg);
     press(est, curves, eo, frozen_of(seg), seg.barrier);
     t_est += seconds_since(t1);
     const FlatStats before = seg.stats;
@@ -82,20 +82,26 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   }
   seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
-  // The final press starts from the estimate (fresh vertices where the
-  // estimate put them, flats on their planes), so it has only the last
-  // stretch to go: no warm start.
-  for (size_t v = 0; v < s.stick_count(); ++v)
-    if (seg.region[v] < 0) s.t[v] = est.t[v];
-  PressOptions final_press = po;
-  final_press.levels = 1;
-  st.press = press(s, curves, final_press, frozen_of(seg), seg.barrier);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
   // by the curved side's fit (fit_creases), and those of creases between
-  // two curved faces by both sides' fits (fit_curved_creases), then the rest
-  // pressed again around them, each round to the tolerance from where the
-  // last one ended.
+  // two curved faces by both sides' fits (fit_curved_creases), then the rest pressed again
+  // around them; the iterations are shared out so the cost is unchanged.
+  // Each round re-presses a fifth of the iterations (fewer past 4 rounds, so
+  // the first press keeps a share).
   const bool creases = fo->passes.on(Pass::crease_fit) && seg.stats.junctions > 0;
+  const int rest = creases ? po.iterations / std::max(5, detail::kCreaseRounds + 1) : 0;
+  PressOptions first = po;
+  first.iterations = po.iterations - detail::kCreaseRounds * rest;
+  // No flat: the final press would be the estimate again (same start, no
+  // frozen vertex, no barrier) when it runs the same schedule and the
+  // estimate never came within its tolerance (where it would have stopped).
+  if (seg.flats.empty() && est_is_plain && first.iterations == eo.iterations && press_levels(s, po.levels) == eo.levels &&
+      first_estimate.least_residual > po.tolerance) {
+    s.t = est.t;
+    st.press = first_estimate;
+  } else {
+    st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
+  }
   for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
     std::vector<uint8_t> fixed;
     const auto t2 = std::chrono::steady_clock::now();
@@ -111,7 +117,9 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
                   round + 1 == detail::kCreaseRounds ? seg.stats.curved_crease_vertices : 0);
     seg.stats.seconds_creases += seconds_since(t2);
     for (size_t v = 0; v < fixed.size(); ++v) fixed[v] |= seg.region[v] >= 0;
-    PressOptions again = final_press;
+    PressOptions again = po;
+    again.iterations = rest;
+    again.levels = 1;  // the fine stage goes on
     const PressStats ps = press(s, curves, again, fixed, barrier);
     st.press.iterations += ps.iterations;
     st.press.seconds += ps.seconds;

@@ -16,7 +16,7 @@ constexpr int kRimRings = 2;             // surface rings a flat takes around it
 constexpr double kRimTangentAngle = 15;  // degrees: a curved side continuing the flat this closely is a fillet (rim-tangent)
 constexpr double kMergeAngle = 4;        // degrees: adjacent flats this close are merged when one plane stabs both
 constexpr double kCurvedGain = 1.3;      // a quadric stabbing this many times as many sticks as the plane refuses the flat
-constexpr double kEstimateTolerance = 1e-3;  // residual of each estimate (the normals settle by then: build/bench/bench_flats)
+constexpr int kEstimateIterations = 100; // Pressing iterations of each estimate (the estimate's normals settle by then)
 constexpr int kDetectionPasses = 2;      // the second re-estimates with the first's flats frozen (faces beside rounded edges)
 // --- junctions (Section 3)
 constexpr double kTangentResidual = 0.1;       // cells RMS: a curved side fitting a quadric this well may be tangent (tangent-borders)

@@ -160,12 +160,10 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   return smooth_sticks(std::move(surface), o, std::move(r));
 }
 
-SurfaceResult smooth_sticks(StickSurface sticks, const SurfaceOptions& o, SurfaceResult r) {
+SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, SurfaceResult r) {
   const MethodOverrides& ov = o.overrides;
   validate(o);
   const auto t0 = std::chrono::steady_clock::now();
-  // Translation-free: every stage on the sticks' own box (on_own_box).
-  StickSurface surface = on_own_box(std::move(sticks));
   switch (o.method) {
     case Method::pressing: {
       press_stick_surface(surface, o, r);

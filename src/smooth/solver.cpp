@@ -7,31 +7,27 @@
 // projected onto the vertex's stick; a vertex's two proposals are combined
 // (PressOptions::weighting) and the vertex moves to
 //   T(t)_i = clamp(t_i + dt_i, margin, 1 - margin);
-// frozen vertices keep their t. The press's result is t* = T(t*), reached
-// when the residual max_i |T(t)_i - t_i| (a fraction of the stick) is below
-// PressOptions::tolerance; PressOptions::iterations is only a safety cap.
+// frozen vertices keep their t. The press approaches t* = T(t*); the
+// residual max_i |T(t)_i - t_i| (a fraction of the stick) says how close
+// (PressStats::residual), and a residual at most PressOptions::tolerance
+// ends the solve.
 //
-// How it is reached. (1) Warm start: the coarse stages of the coarse-to-fine
-// schedule (d times 2^(levels-1), ..., 2) with heavy-ball momentum bring
-// the long waves near their place in a few sweeps; they are a different
-// map, so they only choose where the fine solve starts. (2) The fine solve:
-// Anderson acceleration (type II, Walker & Ni 2011) of T at d, depth
-// kAndersonDepth: each step is the combination of the last maps whose
-// residuals combine to the least-squares smallest, projected on the box;
-// the history restarts when the residual grows. The bilaplacian's slow
-// modes (a curve's long waves damp by (k d)^4 per sweep) are what it
-// removes. Every reduction is summed over fixed blocks in block order, so
-// the result is the same for any thread count.
+// How it is approached (beyond the paper): the sweeps are split evenly into
+// coarse-to-fine stages (d times 2^(levels-1), ..., 2, 1) with heavy-ball
+// momentum on each change of t; the last stage is the map at d, and the
+// solve stops there as soon as the residual is met, or at the sweep cap.
+// The residual is always measured on the map at d at the returned t.
+// Tried and measured (docs/BENCHMARKS.md, Pressing: the solver): Anderson
+// acceleration of the fine map reaches the fixed point, 2.4 times closer to
+// the truth on a sphere, but only in 300-1,500 steps; a multigrid over the
+// same vertices with the map at 2d as the coarse level diverged.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <cstdio>
 #include <numbers>
 
 #include "core/timing.h"
@@ -46,14 +42,6 @@ using detail::seconds_since;
 namespace {
 
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
-// Solver constants (measured: docs/BENCHMARKS.md, Pressing: the solver;
-// `build/bench/bench_converge`).
-constexpr int kWarmSweeps = 20;      // heavy-ball sweeps per coarse stage (the warm start)
-constexpr int kAndersonDepth = 12;   // maps combined per Anderson step
-constexpr int kMaxDepth = 32;        // the deepest history VP_DEPTH may ask
-constexpr double kRestartGrowth = 4; // the history restarts when the residual's norm grows this much in one step
-constexpr size_t kBlock = 1 << 13;   // vertices per block of the deterministic sums
-
 // One sweep of the map at arc length d * scale: step[i] = the combined
 // proposal of vertex i at positions x (0 for frozen vertices).
 class Sweeper {
@@ -200,61 +188,18 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
   });
 }
 
-// Sums over [0, n) in fixed blocks added in block order: the same bits for
-// any thread count. `terms(i, acc)` adds vertex i's K terms into acc.
-template <int K, class Terms>
-std::array<double, K> block_sums(size_t n, const Terms& terms) {
-  const size_t blocks = (n + kBlock - 1) / kBlock;
-  std::vector<std::array<double, K>> part(blocks);
-  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-    std::array<double, K> acc{};
-    const size_t end = std::min(n, (b + 1) * kBlock);
-    for (size_t i = b * kBlock; i < end; ++i) terms(i, acc);
-    part[b] = acc;
-  });
-  std::array<double, K> sum{};
-  for (const auto& p : part)
-    for (int k = 0; k < K; ++k) sum[size_t(k)] += p[size_t(k)];
-  return sum;
-}
-
-double max_abs(const std::vector<double>& f) {
+// max over the fresh vertices of |T(t)_i - t_i|, T(t) = clamp(t + step).
+double residual_of(const std::vector<double>& t, const std::vector<double>& step, const std::vector<uint8_t>& frozen,
+                   double lo, double hi) {
   return tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, f.size(), 1 << 14), 0.0,
+      tbb::blocked_range<size_t>(0, t.size(), 1 << 14), 0.0,
       [&](const tbb::blocked_range<size_t>& r, double acc) {
-        for (size_t i = r.begin(); i < r.end(); ++i) acc = std::max(acc, std::abs(f[i]));
+        for (size_t i = r.begin(); i < r.end(); ++i)
+          if (frozen.empty() || !frozen[i]) acc = std::max(acc, std::abs(std::clamp(t[i] + step[i], lo, hi) - t[i]));
         return acc;
       },
       [](double a, double b) { return std::max(a, b); });
 }
-
-// Anderson acceleration's history: the last `depth` differences of
-// residuals (dF) and of maps (dG), a ring buffer, with their Gram matrix.
-struct History {
-  History(size_t size, int depth) : n(size), dF(size_t(depth)), dG(size_t(depth)), gram(depth, depth) {}
-  size_t n;
-  int count = 0, head = 0;  // columns held; the next column to overwrite
-  std::vector<std::vector<double>> dF, dG;
-  Eigen::MatrixXd gram;
-  int depth() const { return int(dF.size()); }
-
-  void clear() { count = head = 0; }
-  // Adds the column (f - f_prev, g - g_prev).
-  void push(const std::vector<double>& f, const std::vector<double>& fp, const std::vector<double>& g,
-            const std::vector<double>& gp) {
-    const size_t c = size_t(head);
-    if (dF[c].empty()) dF[c].resize(n), dG[c].resize(n);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) dF[c][i] = f[i] - fp[i], dG[c][i] = g[i] - gp[i];
-    });
-    head = (head + 1) % depth();
-    count = std::min(count + 1, depth());
-    const auto dots = block_sums<kMaxDepth>(n, [&](size_t i, auto& acc) {
-      for (int j = 0; j < count; ++j) acc[size_t(j)] += dF[c][i] * dF[size_t(j)][i];
-    });
-    for (int j = 0; j < count; ++j) gram(int(c), j) = gram(j, int(c)) = dots[size_t(j)];
-  }
-};
 
 }  // namespace
 
@@ -271,83 +216,40 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
   if (n == 0 || st.fresh == 0) return st;
   Sweeper sweep(families, per_vertex, frozen, barrier, o, n);
   std::vector<double> step(n);
+  std::vector<double> velocity(o.momentum != 0 ? n : 0, 0.0);
   const double lo = o.margin, hi = 1 - o.margin;
   const int cap = std::max(o.iterations, 0);
   ProgressCounter progress(o.progress, "pressing", uint64_t(cap));
-  // (1) The warm start: heavy-ball sweeps on the coarse stages.
-  std::vector<double> velocity(o.momentum != 0 && levels > 1 ? n : 0, 0.0);
-  const int warm = std::getenv("VP_WARM") ? std::atoi(std::getenv("VP_WARM")) : kWarmSweeps;
-  for (int stage = 0; stage + 1 < levels && cap > 0; ++stage) {
-    const double scale = double(1 << (levels - 1 - stage));
-    for (int k = 0; k < warm; ++k) {
-      sweep(t, scale, step);
-      tbb::parallel_for(size_t(0), n, [&](size_t i) {
-        double dt = step[i];
-        if (!velocity.empty()) dt += o.momentum * velocity[i];
-        const double t_new = frozen.empty() || !frozen[i] ? std::clamp(t[i] + dt, lo, hi) : t[i];
-        if (!velocity.empty()) velocity[i] = t_new - t[i];
-        t[i] = t_new;
-      });
-      ++st.warm_sweeps;
+  bool measured = false;  // st.residual is the residual at the current t
+  bool any = false;       // a residual was measured
+  for (int it = 0; it < cap; ++it) {
+    // Stage of the coarse-to-fine schedule: d * 2^(levels - 1 - stage).
+    const int stage = std::min(levels - 1, it * levels / std::max(cap, 1));
+    sweep(t, double(1 << (levels - 1 - stage)), step);
+    if (stage == levels - 1) {  // the map at d: its residual is the stopping rule
+      st.residual = residual_of(t, step, frozen, lo, hi);
+      st.least_residual = any ? std::min(st.least_residual, st.residual) : st.residual;
+      any = measured = true;
+      if (st.residual <= o.tolerance) break;
     }
-  }
-  velocity = {};
-  // (2) The fine solve: the Anderson-accelerated map at d, until the residual is met.
-  std::vector<double> g(n), f(n), gp(n), fp(n);
-  History hist(n, std::getenv("VP_DEPTH") ? std::atoi(std::getenv("VP_DEPTH")) : kAndersonDepth);
-  double prev_norm = 0;
-  for (int it = 0;; ++it) {
-    sweep(t, 1, step);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-      g[i] = frozen.empty() || !frozen[i] ? std::clamp(t[i] + step[i], lo, hi) : t[i];
-      f[i] = g[i] - t[i];
-    });
-    st.residual = max_abs(f);
-    if (std::getenv("VP_TRACE")) {
-      size_t c1 = 0, c2 = 0, c3 = 0, atb = 0;
-      for (size_t i = 0; i < n; ++i) {
-        const double a = std::abs(f[i]);
-        c1 += a > 0.1 * st.residual; c2 += a > 0.01 * st.residual; c3 += a > 1e-3 * st.residual;
-        atb += (t[i] <= lo || t[i] >= hi);
-      }
-      std::fprintf(stderr, "it %d residual %.3e  >10%%: %zu >1%%: %zu >0.1%%: %zu  at bounds %zu of %zu\n", it, st.residual, c1, c2, c3, atb, n);
-    }
-    st.least_residual = it == 0 ? st.residual : std::min(st.least_residual, st.residual);
-    if (st.residual <= o.tolerance || it >= cap) break;  // t is the point whose residual is reported
-    st.iterations = it + 1;
-    progress.add(1);
-    const double norm = std::sqrt(block_sums<1>(n, [&](size_t i, auto& acc) { acc[0] += f[i] * f[i]; })[0]);
-    if (it > 0 && norm > kRestartGrowth * prev_norm) {
-      hist.clear();
-      ++st.restarts;
-    } else if (it > 0) {
-      hist.push(f, fp, g, gp);
-    }
-    prev_norm = norm;
-    std::swap(f, fp);
-    std::swap(g, gp);  // fp, gp: this step's residual and map
-    if (hist.count == 0) {
-      t = gp;
-      continue;
-    }
-    // gamma = argmin |f - dF gamma|: the normal equations, slightly regularised.
-    const int m = hist.count;
-    const auto rhs = block_sums<kMaxDepth>(n, [&](size_t i, auto& acc) {
-      for (int j = 0; j < m; ++j) acc[size_t(j)] += hist.dF[size_t(j)][i] * fp[i];
-    });
-    Eigen::MatrixXd A = hist.gram.topLeftCorner(m, m);
-    Eigen::VectorXd b(m);
-    for (int j = 0; j < m; ++j) b[j] = rhs[size_t(j)];
-    A.diagonal().array() += 1e-10 * A.diagonal().maxCoeff() + 1e-300;
-    const Eigen::VectorXd gamma = A.ldlt().solve(b);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         if (!frozen.empty() && frozen[i]) continue;
-        double x = gp[i];
-        for (int j = 0; j < m; ++j) x -= gamma[j] * hist.dG[size_t(j)][i];
-        t[i] = std::clamp(x, lo, hi);
+        double dt = step[i];
+        if (!velocity.empty()) dt += o.momentum * velocity[i];
+        const double t_new = std::clamp(t[i] + dt, lo, hi);
+        if (!velocity.empty()) velocity[i] = t_new - t[i];
+        t[i] = t_new;
       }
     });
+    measured = false;
+    st.iterations = it + 1;
+    progress.add(1);
+  }
+  if (!measured) {  // the cap ended the solve: the residual at the returned t
+    sweep(t, 1, step);
+    st.residual = residual_of(t, step, frozen, lo, hi);
+    st.least_residual = any ? std::min(st.least_residual, st.residual) : st.residual;
   }
   st.seconds = seconds_since(t0);
   return st;

@@ -48,15 +48,6 @@ struct StickSurface {
   Vec3 outside_sample(size_t s) const { return sample_points(s)[lower_inside(s) ? 1 : 0]; }
 };
 
-/// The same surface on its own lattice: the source lattice cropped to the
-/// box of the sticks' samples, its origin moved there. Stick order, codes,
-/// t and triangles are unchanged; only the lower indices are rebased. Every
-/// stage after extraction works in index coordinates, so on this lattice a
-/// shifted, padded or cropped volume gives them the same numbers, hence the
-/// same t (smooth_sticks runs on it; the physical output differs by the
-/// rounding of the origin only).
-StickSurface on_own_box(StickSurface surface);
-
 struct ExtractOptions {
   Progress* progress = nullptr;  ///< optional progress sink and cancellation
   uint64_t max_bytes = 0;        ///< refuse (LimitError) if the output would exceed this; 0 = no cap

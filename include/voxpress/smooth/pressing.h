@@ -17,13 +17,13 @@
 //   the displacement s^2 L^2(C) projected onto the stick's line;
 // each stick lies in two planes, so it gets two proposals, which are averaged
 // (equal weights by default) before the clamp to [margin, 1 - margin].
-// The press's result is the fixed point t* = T(t*) (frozen vertices kept),
-// reached to PressOptions::tolerance on the residual max |T(t) - t| by
-// Anderson-accelerated steps after a coarse-to-fine warm start
-// (src/smooth/solver.cpp). Every step is simultaneous (Jacobi) and every sum
-// is taken in a fixed order, so the result does not depend on the order or
-// the thread count; positions are relative to the sticks' box, so it does
-// not depend on where the volume lies either.
+// The press approaches the fixed point t* = T(t*) (frozen vertices kept):
+// coarse-to-fine stages with momentum, then the map at d until its residual
+// max |T(t) - t| is at most PressOptions::tolerance or the sweeps run out
+// (src/smooth/solver.cpp; PressStats::residual says how close it came).
+// Every sweep is simultaneous (Jacobi), so the result does not depend on
+// the order or the thread count; positions are relative to the sticks'
+// box, so it does not depend on where the volume lies either.
 #pragma once
 
 #include <cstdint>
@@ -56,12 +56,11 @@ struct SliceCurves {
 SliceCurves build_slice_curves(const StickSurface& surface);
 
 struct PressOptions {
-  /// Safety cap on the fine solve's steps; the stopping rule is the
-  /// tolerance (docs/BENCHMARKS.md, Pressing: the solver, has the counts).
-  int iterations = 3000;
-  /// Stop once the residual max |T(t) - t| (a fraction of the stick) is at
-  /// most this (measured: docs/BENCHMARKS.md, Pressing: the solver).
-  double tolerance = 1e-5;
+  /// Sweeps (all stages; chosen by measurement: docs/BENCHMARKS.md).
+  int iterations = 100;
+  /// Stop once the residual of the map at d, max |T(t) - t| (a fraction
+  /// of the stick), is at most this (checked in the last stage).
+  double tolerance = 1e-4;
   double step = 0.85;          ///< s in C'' = C + s^2 L^2(C) (paper: 0.85)
   double arc_length = 0.75;    ///< d, in cells of the curve's plane (paper: 0.75)
   double margin = 0.01;        ///< t is kept in [margin, 1 - margin]
@@ -69,19 +68,17 @@ struct PressOptions {
   /// equal weights, or weights proportional to |stick . curve normal| or to
   /// |stick . curve tangent| in each plane.
   enum class Weighting { equal, normal, tangent } weighting = Weighting::equal;
-  /// Beyond the paper — the warm start (it chooses where the fine solve
-  /// starts, not where it ends; docs/BENCHMARKS.md has the measurements):
-  /// coarse-to-fine: `levels` - 1 coarse stages of a fixed number of sweeps
-  /// with d multiplied by 2^(levels - 1), ..., 2 before the solve at d
-  /// (1: no warm start).
+  /// Beyond the paper — acceleration (docs/BENCHMARKS.md has the measurements):
+  /// coarse-to-fine: the sweeps are split evenly into `levels` stages with
+  /// d multiplied by 2^(levels - 1), ..., 2, 1 (1: the paper's single d).
   /// 0 = by the surface's extent E, the longest side of its bounding box in
   /// cells: 2 stages while E < 192, one more each time E doubles (3 up to
   /// 383, 4 up to 767, ...), so the coarsest d spans about the same share of
   /// the solid at every resolution (measured: docs/BENCHMARKS.md, Pressing,
   /// Levels by extent);
   int levels = 0;
-  /// heavy-ball momentum of the warm start's sweeps: each adds momentum
-  /// times the vertex's previous change of t.
+  /// heavy-ball momentum: each update adds momentum times the vertex's
+  /// previous change of t (0: the paper's plain iteration).
   double momentum = 0.8;
   /// Arc-length resampling (paper, Fig. 5-6). false: the plain bilaplacian of
   /// the actual curve neighbours, kept to reproduce Fig. 5's comparison.
@@ -115,12 +112,10 @@ struct PressOptions {
 };
 
 struct PressStats {
-  int iterations = 0;              ///< steps of the fine solve (applications of the map at d)
-  int warm_sweeps = 0;             ///< sweeps of the coarse stages (the warm start)
+  int iterations = 0;              ///< sweeps run (all stages)
   int levels = 0;                  ///< coarse-to-fine stages used (PressOptions::levels resolved)
-  int restarts = 0;                ///< times the acceleration's history was dropped
-  double residual = 0;             ///< max |T(t) - t| at the result, a fraction of the stick (the stopping rule)
-  double least_residual = 0;       ///< the smallest residual met during the fine solve
+  double residual = 0;             ///< max |T(t) - t| of the map at d at the result, a fraction of the stick
+  double least_residual = 0;       ///< the smallest residual met in the last stage
   size_t curves = 0, fresh = 0, frozen = 0;
   double seconds = 0;
 };
