@@ -151,8 +151,9 @@ void PressCli::bind(CLI::App& cmd, bool barriers) {
                                     "110 taubin, 20 laplacian)")
                           ->capture_default_str();
   tolerance_option = g->add_option("--tolerance", options.tolerance,
-                                   "Stop when no vertex moves more than this (fraction of a stick; cells for cesn "
-                                   "and the constraints, default 0.002)")
+                                   "Pressing: stop when the residual max |T(t) - t| of the map at d is at most this "
+                                   "(fraction of a stick); cesn and the constraints: when no vertex moves more "
+                                   "(cells, default 0.002)")
                          ->capture_default_str();
   g->add_option("--step", options.step, "s in C'' = C + s^2 L^2(C)")->capture_default_str();
   g->add_option("--arc-length", options.arc_length, "d: virtual-neighbour distance, in cells")->capture_default_str();
