@@ -42,6 +42,7 @@ using detail::seconds_since;
 namespace {
 
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
+
 // One sweep of the map at arc length d * scale: step[i] = the combined
 // proposal of vertex i at positions x (0 for frozen vertices).
 class Sweeper {
@@ -57,10 +58,12 @@ class Sweeper {
 
   void operator()(const std::vector<double>& x, double scale, std::vector<double>& step) {
     for (const Family& fam : fams_) family(fam, x, scale);
-    combine(x.size(), step, weighted_);
+    combine(x.size(), step);
   }
+
  private:
-  void combine(size_t n, std::vector<double>& step, bool weighted) {
+  // step[i]: vertex i's proposals combined (PressOptions::weighting).
+  void combine(size_t n, std::vector<double>& step) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         if (!frozen_.empty() && frozen_[i]) {
@@ -70,7 +73,7 @@ class Sweeper {
         const double* p = &prop_[size_t(per_vertex_) * i];
         if (per_vertex_ == 1) {
           step[i] = p[0];
-        } else if (weighted) {
+        } else if (weighted_) {
           const double w0 = weight_[2 * i], w1 = weight_[2 * i + 1];
           step[i] = w0 + w1 > 0 ? (w0 * p[0] + w1 * p[1]) / (w0 + w1) : 0;
         } else {
