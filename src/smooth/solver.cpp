@@ -135,9 +135,6 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
         const double tk = t[ids[k]], mv = double(fam.mov[k]);
         w.pos[i] = Vec2(fam.base[k].x() + (1 - mv) * tk, fam.base[k].y() + mv * tk);
       };
-      auto apply = [&](uint32_t count, bool closed, bool free_ends) {
-        detail::curve_step(count, closed, d, s2_, o_.resample, weighted_, correction_, g, w, free_ends);
-      };
       // A curve, or a piece, whose vertices are all frozen proposes
       // nothing anyone reads (on a CAD part most of the vertices are
       // frozen flats, cut off by their barriers): skipped.
@@ -152,7 +149,7 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
         if (!any_free(sp.lo, sp.hi - sp.lo)) continue;
         w.resize(m);
         for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
-        apply(m, false, sp.free != 0);
+        detail::curve_step(m, false, d, s2_, o_.resample, weighted_, correction_, g, w, sp.free != 0);
         for (uint32_t i = sp.lo; i < sp.hi; ++i) emit(b + i, i);
         continue;
       }
@@ -166,7 +163,7 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
         if (!any_free(0, m)) continue;
         w.resize(m);
         for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
-        apply(m, true, false);
+        detail::curve_step(m, true, d, s2_, o_.resample, weighted_, correction_, g, w);
         for (uint32_t i = 0; i < m; ++i) emit(b + i, i);
         continue;
       }
@@ -183,7 +180,7 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
         const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
         w.resize(count);
         for (uint32_t i = 0; i < count; ++i) gather(i, b + (first_barrier + k + lo + i) % m);
-        apply(count, false, loose);
+        detail::curve_step(count, false, d, s2_, o_.resample, weighted_, correction_, g, w, loose);
         for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, i - lo);
         k += len;
       }
