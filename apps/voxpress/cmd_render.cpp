@@ -25,11 +25,17 @@ bool is_voxel_art_path(const std::string& path) {
   return ext == ".vox" || ext == ".vxl";
 }
 
-Mesh display_surface(const BinaryVolume& volume, const std::string& method, SurfaceResult* result) {
-  if (method == "voxels") return voxel_faces(volume);
-  if (method == "midpoint") return to_mesh(extract_sticks(volume));
+Mesh display_surface(const BinaryVolume& volume, const std::string& method, uint64_t max_bytes, uint64_t held_bytes,
+                     SurfaceResult* result) {
+  if (method == "voxels") return voxel_faces(volume, max_bytes, held_bytes);
+  ExtractOptions eo;
+  eo.max_bytes = max_bytes;
+  eo.held_bytes = held_bytes;
+  if (method == "midpoint") return to_mesh(extract_sticks(volume, eo));
   SurfaceOptions o;
   o.method = parse_method(method);
+  o.extract.max_bytes = max_bytes;
+  o.extract.held_bytes = held_bytes;
   SurfaceResult r = smooth_surface(volume, o);
   Mesh mesh = std::move(r.mesh);
   if (result) *result = std::move(r);
@@ -91,7 +97,7 @@ void run_render(const RenderCmd& c, const Global& g) {
       vo.fairing = parse_voxart_fairing(method.empty() ? "lanczos" : method == "voxels" ? "none" : method);
       mesh = polygonize_voxel_art(read_voxel_art(path, ro), vo).mesh;
     } else {
-      mesh = display_surface(load_binary(path, c.in, g), method.empty() ? "pressing" : method);
+      mesh = display_surface(load_binary(path, c.in, g), method.empty() ? "pressing" : method, g.memory_limit(), 0);
     }
     if (mesh.triangles.empty()) throw InputError(path, "has no triangles to draw");
     meshes.push_back(std::move(mesh));

@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "common.h"
+#include "voxpress/core/memory_budget.h"
 #include "voxpress/eval/metrics.h"
 #include "voxpress/eval/truth.h"
 #include "voxpress/render/render.h"
@@ -198,11 +199,21 @@ void run_report(const ReportCmd& c, const Global& g) {
   };
   std::vector<Entry> entries;
   methods.insert(methods.begin(), "voxels");
+  // What --max-memory charges (memory_budget.h): each surface is made within
+  // the cap less what the run holds by then (the volume as read and the
+  // meshes kept for the page, each also encoded into it).
+  const uint64_t cap = g.memory_limit();
+  uint64_t held = raw.bytes.size();
   for (const std::string& m : methods) {
     Stopwatch clock;
     nlohmann::json s;
     SurfaceResult r;
-    Mesh mesh = display_surface(volume, m, &r);
+    Mesh mesh = display_surface(volume, m, cap, held, &r);
+    held += 2 * (mesh.positions.size() * kMeshBytesPerVertex + mesh.triangles.size() * kMeshBytesPerTriangle);
+    if (truth && m != "voxels")
+      charge_memory(c.input, held + mesh.triangles.size() * kEvalBytesPerResultFace, cap,
+                    "measuring " + m + "'s " + std::to_string(mesh.triangles.size()) + " faces against the truth (" +
+                        std::to_string(kEvalBytesPerResultFace) + " bytes each)");
     s["seconds"] = clock.seconds();
     if (m == "voxels") {
       entries.push_back({m, std::move(mesh), s});

@@ -191,6 +191,9 @@ bool is_voxel_art_path(const std::string& path);  ///< .vox .vxl
 /// A volume's surface for display: "voxels" (cell faces), "midpoint", or a
 /// press method name with its defaults (throws UsageError otherwise). For a
 /// press method, `result` (when given) receives its stats (mesh moved out).
-Mesh display_surface(const BinaryVolume& volume, const std::string& method, SurfaceResult* result = nullptr);
+/// `max_bytes`: the memory cap for the surface and its making with what the
+/// caller holds besides the volume, `held_bytes` (0: no cap).
+Mesh display_surface(const BinaryVolume& volume, const std::string& method, uint64_t max_bytes, uint64_t held_bytes,
+                     SurfaceResult* result = nullptr);
 
 }  // namespace voxpress::cli

@@ -190,7 +190,7 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
   // Triangles are about twice the vertices (each vertex has ~6 incident
   // triangles, each triangle 3 vertices); 17 bytes per stick, 12 per triangle.
   const uint64_t surface = total * (17 + 2 * 12), later = total * options.later_bytes_per_stick;
-  const uint64_t estimate = volume.inside.size() + surface + later + kRunBytesFixed;
+  const uint64_t estimate = options.held_bytes + volume.inside.size() + surface + later + kRunBytesFixed;
   if (options.max_bytes && estimate > options.max_bytes) {
     const bool small = options.max_bytes < (16u << 20);  // KiB below 16 MiB, so that no figure reads 0
     auto size = [&](uint64_t b) { return std::to_string(small ? b >> 10 : b >> 20); };
@@ -198,7 +198,9 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
     throw LimitError(volume.source, "this needs about " + size(estimate) + unit + " (volume " +
                                         size(volume.inside.size()) + ", surface " + size(surface) +
                                         ", its smoothing " + size(later) + " for " + std::to_string(total) +
-                                        " sticks, the run " + size(kRunBytesFixed) + "), above the memory limit of " +
+                                        " sticks, the run " + size(kRunBytesFixed) +
+                                        (options.held_bytes ? ", held before " + size(options.held_bytes) : "") +
+                                        "), above the memory limit of " +
                                         size(options.max_bytes) + unit);
   }
   out.lower.resize(total);

@@ -3,12 +3,17 @@
 // key light above the viewer, box-filtered down to the output size.
 #include "voxpress/render/render.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
 
 #include "voxpress/core/error.h"
+#include "voxpress/core/memory_budget.h"
 
 namespace voxpress {
 
@@ -230,9 +235,26 @@ Texture side_by_side(const std::vector<Texture>& pictures, int gap) {
   return out;
 }
 
-Mesh voxel_faces(const BinaryVolume& volume) {
+Mesh voxel_faces(const BinaryVolume& volume, uint64_t max_bytes, uint64_t held_bytes) {
   const Lattice& L = volume.lattice;
   const auto& d = L.dims;
+  if (max_bytes) {  // counted before anything is built
+    const uint64_t faces = tbb::parallel_reduce(
+        tbb::blocked_range<int64_t>(0, d[2]), uint64_t(0),
+        [&](const tbb::blocked_range<int64_t>& r, uint64_t acc) {
+          for (int64_t k = r.begin(); k < r.end(); ++k)
+            for (int64_t j = 0; j < d[1]; ++j)
+              for (int64_t i = 0; i < d[0]; ++i)
+                if (volume.at(i, j, k))
+                  acc += !volume.at(i - 1, j, k) + !volume.at(i + 1, j, k) + !volume.at(i, j - 1, k) +
+                         !volume.at(i, j + 1, k) + !volume.at(i, j, k - 1) + !volume.at(i, j, k + 1);
+          return acc;
+        },
+        std::plus<>());
+    charge_memory(volume.source, held_bytes + volume.inside.size() + faces * kVoxelFaceBytes + kRunBytesFixed, max_bytes,
+                  "drawing its " + std::to_string(faces) + " voxel faces (" + std::to_string(kVoxelFaceBytes) +
+                      " bytes each)");
+  }
   Mesh m;
   std::unordered_map<uint64_t, uint32_t> corner_index;
   const uint64_t cx = uint64_t(d[0]) + 1, cy = uint64_t(d[1]) + 1;

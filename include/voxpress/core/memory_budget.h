@@ -52,6 +52,11 @@ inline constexpr uint64_t kLabelBytesPerLabel = 128 << 10;
 /// (`voxpress render armadillo.obj -o a.png`: 43 243 vertices, 86 482 faces).
 inline constexpr uint64_t kMeshBytesPerVertex = 48, kMeshBytesPerTriangle = 24;
 
+/// The voxel faces of a preview (render, report), per face: two triangles,
+/// about one shared corner and its hash entry (`voxpress report
+/// totalseg_heart.nii.gz --methods voxels`).
+inline constexpr uint64_t kVoxelFaceBytes = 160;
+
 /// Throws LimitError naming `path` when `bytes` exceed `cap` (0: no cap):
 /// "<what> needs N, above the memory limit of M" in MiB, KiB or bytes.
 void charge_memory(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);

@@ -55,6 +55,7 @@ struct ExtractOptions {
   /// method's measured peak), counted against max_bytes with the volume and
   /// the surface, so a run that cannot fit is refused before any work on it.
   uint64_t later_bytes_per_stick = 0;
+  uint64_t held_bytes = 0;  ///< what the caller already holds, counted with the estimate against max_bytes
 };
 
 struct ExtractStats {

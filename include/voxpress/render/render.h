@@ -51,8 +51,11 @@ Texture side_by_side(const std::vector<Texture>& pictures, int gap = 8);
 
 /// The boundary faces of the inside voxels (each sample drawn as the cube of
 /// its cell), in physical units, outward: the "input voxels" of previews.
-/// Corners are shared; not guaranteed manifold (display only).
-Mesh voxel_faces(const BinaryVolume& volume);
+/// Corners are shared; not guaranteed manifold (display only). LimitError
+/// naming the volume when `held_bytes` (what the caller holds besides the
+/// volume), the volume and the faces would exceed `max_bytes` (0: no cap;
+/// memory_budget.h).
+Mesh voxel_faces(const BinaryVolume& volume, uint64_t max_bytes = 0, uint64_t held_bytes = 0);
 
 /// A colour for region id `region` (>= 0), distinct for neighbouring ids.
 std::array<uint8_t, 3> region_color(int64_t region);
