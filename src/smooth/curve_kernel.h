@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "voxpress/core/types.h"
@@ -65,13 +66,12 @@ struct Scratch {
   }
 };
 
-// Displacement proposals s^2 L^2(C) for the n vertices w.pos of one curve
-// (closed, or open with fixed or free ends), in the plane's index coordinates, and
-// unit tangents (index coordinates, unit in the metric) for the weightings.
-// Section 4, Fig. 4-6: virtual neighbours at arc length d, two Laplacian passes.
+// The first half of curve_step: the virtual neighbours w.fwd, w.bwd, the
+// Laplacian w.lap, the circle correction's w.shrink and the tangents; false
+// (every w.disp and w.tangent zero) on a degenerate curve.
 template <class V, class G>
-void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool tangents, double correction,
-                const G& g, Scratch<V>& w, bool free_ends = false) {
+bool curve_locate(size_t n, bool closed, double d, bool resample, bool tangents, double correction, const G& g,
+                  Scratch<V>& w, bool free_ends) {
   const V* p = w.pos.data();
   double* len = w.len.data();
   Where* fwd = w.fwd.data();
@@ -86,7 +86,7 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
   }
   if (!(perimeter > 0) || n < 3) {
     for (size_t i = 0; i < n; ++i) w.disp[i] = w.tangent[i] = V::Zero();
-    return;
+    return false;
   }
   // A closed curve shorter than d: wrap d (Fig. 6 on a tiny loop).
   const double dd = closed && d >= perimeter ? std::fmod(d, perimeter) : d;
@@ -169,6 +169,22 @@ void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool 
       w.tangent[i] = l > 0 ? V(tg / l) : V::Zero();
     }
   }
+  return true;
+}
+
+// Displacement proposals s^2 L^2(C) for the n vertices w.pos of one curve
+// (closed, or open with fixed or free ends), in the plane's index coordinates, and
+// unit tangents (index coordinates, unit in the metric) for the weightings.
+// Section 4, Fig. 4-6: virtual neighbours at arc length d, two Laplacian passes.
+template <class V, class G>
+void curve_step(size_t n, bool closed, double d, double s2, bool resample, bool tangents, double correction,
+                const G& g, Scratch<V>& w, bool free_ends = false) {
+  if (!curve_locate(n, closed, d, resample, tangents, correction, g, w, free_ends)) return;
+  const auto next = [n](size_t k) { return k + 1 == n ? size_t(0) : k + 1; };
+  const V* lap = w.lap.data();
+  const double* shrink = w.shrink.data();
+  const Where* fwd = w.fwd.data();
+  const Where* bwd = w.bwd.data();
   // Pass 2: the Laplacian of the Laplacian, interpolated at the same places.
   // Past a free end the Laplacian is taken as 0 (the end's own, since its
   // virtual neighbours are each other's reflection).
@@ -219,6 +235,26 @@ struct Family {
 // and are fixed points of the curves; `barrier` vertices (frozen ones) cut
 // the curves into open pieces (PressOptions::free_ends). `levels` as
 // press_levels resolved it. Jacobi updates: deterministic for any thread count.
+/// One application of the map's step at arc length d * scale: step[i] the
+/// combined proposal of vertex i at t (0 for frozen vertices).
+using SweepFn = std::function<void(const std::vector<double>& t, double scale, std::vector<double>& step)>;
+SweepFn make_sweep(const std::vector<Family>& families, int per_vertex, const std::vector<uint8_t>& frozen,
+                   const std::vector<uint8_t>& barrier, const PressOptions& o, size_t n);
+
+/// The press's layout of a surface: vertices in brick Morton order relative
+/// to the sticks' box (new_of[stick] = vertex, old_of[vertex] = stick), the
+/// three plane families, and the press's levels for its extent.
+struct Layout {
+  std::vector<uint32_t> old_of, new_of;
+  std::vector<uint32_t> ids[3];
+  std::vector<Family> families;
+  int64_t extent = 0;
+  Layout() = default;
+  Layout(const Layout&) = delete;
+  Layout& operator=(const Layout&) = delete;
+};
+void make_layout(const StickSurface& s, const SliceCurves& curves, Layout& out);
+
 PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
                    const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier, const PressOptions& o,
                    int levels);

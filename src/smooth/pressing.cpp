@@ -84,13 +84,8 @@ int64_t extent_of(const IndexBox<D>& box) {
 
 }  // namespace
 
-PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions& o, const std::vector<uint8_t>& frozen,
-                 const std::vector<uint8_t>& barrier) {
+void detail::make_layout(const StickSurface& s, const SliceCurves& curves, Layout& out) {
   const size_t n = s.stick_count();
-  if (!frozen.empty() && frozen.size() != n) throw std::invalid_argument("press: frozen flags do not match the sticks");
-  if (!barrier.empty() && barrier.size() != n) throw std::invalid_argument("press: barrier flags do not match the sticks");
-  for (size_t i = 0; i < barrier.size(); ++i)
-    if (barrier[i] && (frozen.empty() || !frozen[i])) throw std::invalid_argument("press: a barrier vertex must be frozen");
   // Renumber the vertices in 8^3-brick Morton order for the iteration. The
   // canonical (row) order puts consecutive vertices of an x-plane curve a
   // whole row apart, so every access misses the cache; in brick order a
@@ -108,20 +103,19 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
     sorted[i] = {m, uint32_t(i)};
   });
   tbb::parallel_sort(sorted.begin(), sorted.end());
-  std::vector<uint32_t> old_of(n), new_of(n);
-  std::vector<double> t(n);
-  std::vector<uint8_t> fz(frozen.empty() ? 0 : n), br(barrier.empty() ? 0 : n);
+  auto& old_of = out.old_of;
+  auto& new_of = out.new_of;
+  old_of.resize(n);
+  new_of.resize(n);
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
     const uint32_t old = sorted[i].second;
     old_of[i] = old;
     new_of[old] = uint32_t(i);
-    t[i] = s.t[old];
-    if (!fz.empty()) fz[i] = frozen[old];
-    if (!br.empty()) br[i] = barrier[old];
   });
   const Mat3 M = s.lattice.index_to_physical_matrix();
-  std::vector<Family> families(3);
-  std::vector<uint32_t> ids[3];
+  auto& families = out.families;
+  families.assign(3, Family{});
+  auto& ids = out.ids;
   for (int a = 0; a < 3; ++a) {
     const int u = (a + 1) % 3, v = (a + 2) % 3;
     Family& f = families[size_t(a)];
@@ -143,8 +137,28 @@ PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions&
       f.dst[k] = 2 * new_of[id] + uint32_t(SliceCurves::slot(a, s.axis(id)));
     });
   }
-  const PressStats st = detail::iterate(t, families, 2, fz, br, o, press_levels_for_extent(o.levels, extent_of<3>(box)));
-  tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[old_of[i]] = t[i]; });
+  out.extent = extent_of<3>(box);
+}
+
+PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions& o, const std::vector<uint8_t>& frozen,
+                 const std::vector<uint8_t>& barrier) {
+  const size_t n = s.stick_count();
+  if (!frozen.empty() && frozen.size() != n) throw std::invalid_argument("press: frozen flags do not match the sticks");
+  if (!barrier.empty() && barrier.size() != n) throw std::invalid_argument("press: barrier flags do not match the sticks");
+  for (size_t i = 0; i < barrier.size(); ++i)
+    if (barrier[i] && (frozen.empty() || !frozen[i])) throw std::invalid_argument("press: a barrier vertex must be frozen");
+  detail::Layout L;
+  detail::make_layout(s, curves, L);
+  std::vector<double> t(n);
+  std::vector<uint8_t> fz(frozen.empty() ? 0 : n), br(barrier.empty() ? 0 : n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    const uint32_t old = L.old_of[i];
+    t[i] = s.t[old];
+    if (!fz.empty()) fz[i] = frozen[old];
+    if (!br.empty()) br[i] = barrier[old];
+  });
+  const PressStats st = detail::iterate(t, L.families, 2, fz, br, o, press_levels_for_extent(o.levels, L.extent));
+  tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[L.old_of[i]] = t[i]; });
   return st;
 }
 

@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "core/timing.h"
@@ -42,6 +43,54 @@ using detail::seconds_since;
 namespace {
 
 constexpr size_t kAhead = 32;  // prefetch distance, in curve vertices
+
+// Curve c of a family as the pieces the kernel runs on: f(count, closed,
+// free_ends, kof, elo, ehi) with kof(i) the curve-vertex index of the
+// piece's point i and [elo, ehi) the points that propose.
+template <class F>
+void for_each_piece(const Family& fam, size_t c, const std::vector<uint8_t>& frozen,
+                    const std::vector<uint8_t>& barrier, bool free_ends, F&& f) {
+  const uint32_t* ids = fam.ids->data();
+  const uint32_t b = (*fam.offsets)[c], m = (*fam.offsets)[c + 1] - b;
+  // A curve, or a piece, whose vertices are all frozen proposes nothing
+  // anyone reads (on a CAD part most of the vertices are frozen flats, cut
+  // off by their barriers): skipped.
+  const auto any_free = [&](uint32_t from, uint32_t count) {
+    if (frozen.empty()) return true;
+    for (uint32_t i = 0; i < count; ++i)
+      if (!frozen[ids[b + (from + i) % m]]) return true;
+    return false;
+  };
+  const auto straight = [b](uint32_t i) { return b + i; };
+  if (!fam.spans.empty() && fam.spans[c].open) {  // an open polyline with context ends
+    const Family::Span& sp = fam.spans[c];
+    if (any_free(sp.lo, sp.hi - sp.lo)) f(m, false, sp.free != 0, straight, sp.lo, sp.hi);
+    return;
+  }
+  // The curve, or its open pieces between barrier vertices, each piece
+  // starting and ending at a barrier (cyclically).
+  uint32_t first_barrier = m;
+  if (!barrier.empty())
+    for (uint32_t i = 0; i < m && first_barrier == m; ++i)
+      if (barrier[ids[b + i]]) first_barrier = i;
+  if (first_barrier == m) {
+    if (any_free(0, m)) f(m, true, false, straight, 0, m);
+    return;
+  }
+  // Open pieces from barrier to barrier; the barrier ends stay fixed.
+  for (uint32_t k = 0; k < m;) {
+    uint32_t len = 1;
+    while (!barrier[ids[b + (first_barrier + k + len) % m]]) ++len;
+    if (any_free(first_barrier + k + 1, len - 1)) {
+      // Free ends: the piece without its two barriers (PressOptions::free_ends).
+      const bool loose = free_ends && len >= detail::kFreePiece;
+      const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
+      const uint32_t from = first_barrier + k + lo;
+      f(count, false, loose, [=](uint32_t i) { return b + (from + i) % m; }, 1 - lo, len - lo);
+    }
+    k += len;
+  }
+}
 
 // One sweep of the map at arc length d * scale: step[i] = the combined
 // proposal of vertex i at positions x (0 for frozen vertices).
@@ -111,7 +160,6 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
   tbb::parallel_for(tbb::blocked_range<size_t>(0, off.size() - 1, 32), [&](const tbb::blocked_range<size_t>& r) {
     detail::Scratch<Vec2> w;
     for (size_t c = r.begin(); c < r.end(); ++c) {
-      const uint32_t b = off[c], m = off[c + 1] - b;
       auto emit = [&](uint32_t k, uint32_t i) {  // k: curve-vertex index, i: its place in the scratch
         const int mv = fam.mov[k];
         const uint32_t q = fam.dst[k];
@@ -135,55 +183,13 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
         const double tk = t[ids[k]], mv = double(fam.mov[k]);
         w.pos[i] = Vec2(fam.base[k].x() + (1 - mv) * tk, fam.base[k].y() + mv * tk);
       };
-      // A curve, or a piece, whose vertices are all frozen proposes
-      // nothing anyone reads (on a CAD part most of the vertices are
-      // frozen flats, cut off by their barriers): skipped.
-      const auto any_free = [&](uint32_t from, uint32_t count) {
-        if (frozen.empty()) return true;
-        for (uint32_t i = 0; i < count; ++i)
-          if (!frozen[ids[b + (from + i) % m]]) return true;
-        return false;
-      };
-      if (!fam.spans.empty() && fam.spans[c].open) {  // an open polyline with context ends
-        const Family::Span& sp = fam.spans[c];
-        if (!any_free(sp.lo, sp.hi - sp.lo)) continue;
-        w.resize(m);
-        for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
-        detail::curve_step(m, false, d, s2_, o_.resample, weighted_, correction_, g, w, sp.free != 0);
-        for (uint32_t i = sp.lo; i < sp.hi; ++i) emit(b + i, i);
-        continue;
-      }
-      // The curve, or its open pieces between barrier vertices, each
-      // piece starting and ending at a barrier (cyclically).
-      uint32_t first_barrier = m;
-      if (!barrier.empty())
-        for (uint32_t i = 0; i < m && first_barrier == m; ++i)
-          if (barrier[ids[b + i]]) first_barrier = i;
-      if (first_barrier == m) {
-        if (!any_free(0, m)) continue;
-        w.resize(m);
-        for (uint32_t i = 0; i < m; ++i) gather(i, b + i);
-        detail::curve_step(m, true, d, s2_, o_.resample, weighted_, correction_, g, w);
-        for (uint32_t i = 0; i < m; ++i) emit(b + i, i);
-        continue;
-      }
-      // Open pieces from barrier to barrier; the barrier ends stay fixed.
-      for (uint32_t k = 0; k < m;) {
-        uint32_t len = 1;
-        while (!barrier[ids[b + (first_barrier + k + len) % m]]) ++len;
-        if (!any_free(first_barrier + k + 1, len - 1)) {
-          k += len;
-          continue;
-        }
-        // Free ends: the piece without its two barriers (PressOptions::free_ends).
-        const bool loose = o_.free_ends && len >= detail::kFreePiece;
-        const uint32_t lo = loose ? 1 : 0, count = loose ? len - 1 : len + 1;
+      for_each_piece(fam, c, frozen, barrier, o_.free_ends, [&](uint32_t count, bool closed, bool loose, auto&& kof,
+                                                                 uint32_t elo, uint32_t ehi) {
         w.resize(count);
-        for (uint32_t i = 0; i < count; ++i) gather(i, b + (first_barrier + k + lo + i) % m);
-        detail::curve_step(count, false, d, s2_, o_.resample, weighted_, correction_, g, w, loose);
-        for (uint32_t i = 1; i < len; ++i) emit(b + (first_barrier + k + i) % m, i - lo);
-        k += len;
-      }
+        for (uint32_t i = 0; i < count; ++i) gather(i, kof(i));
+        detail::curve_step(count, closed, d, s2_, o_.resample, weighted_, correction_, g, w, loose);
+        for (uint32_t i = elo; i < ehi; ++i) emit(kof(i), i);
+      });
     }
   });
 }
@@ -202,6 +208,13 @@ double residual_of(const std::vector<double>& t, const std::vector<double>& step
 }
 
 }  // namespace
+
+detail::SweepFn detail::make_sweep(const std::vector<Family>& families, int per_vertex,
+                                   const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier,
+                                   const PressOptions& o, size_t n) {
+  auto sw = std::make_shared<Sweeper>(families, per_vertex, frozen, barrier, o, n);
+  return [sw](const std::vector<double>& t, double scale, std::vector<double>& step) { (*sw)(t, scale, step); };
+}
 
 PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
                            const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier,
