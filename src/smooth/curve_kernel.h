@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "voxpress/core/types.h"
@@ -235,12 +234,6 @@ struct Family {
 // and are fixed points of the curves; `barrier` vertices (frozen ones) cut
 // the curves into open pieces (PressOptions::free_ends). `levels` as
 // press_levels resolved it. Jacobi updates: deterministic for any thread count.
-/// One application of the map's step at arc length d * scale: step[i] the
-/// combined proposal of vertex i at t (0 for frozen vertices).
-using SweepFn = std::function<void(const std::vector<double>& t, double scale, std::vector<double>& step)>;
-SweepFn make_sweep(const std::vector<Family>& families, int per_vertex, const std::vector<uint8_t>& frozen,
-                   const std::vector<uint8_t>& barrier, const PressOptions& o, size_t n);
-
 /// The press's layout of a surface: vertices in brick Morton order relative
 /// to the sticks' box (new_of[stick] = vertex, old_of[vertex] = stick), the
 /// three plane families, and the press's levels for its extent.

@@ -28,7 +28,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <memory>
 #include <numbers>
 
 #include "core/timing.h"
@@ -208,13 +207,6 @@ double residual_of(const std::vector<double>& t, const std::vector<double>& step
 }
 
 }  // namespace
-
-detail::SweepFn detail::make_sweep(const std::vector<Family>& families, int per_vertex,
-                                   const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier,
-                                   const PressOptions& o, size_t n) {
-  auto sw = std::make_shared<Sweeper>(families, per_vertex, frozen, barrier, o, n);
-  return [sw](const std::vector<double>& t, double scale, std::vector<double>& step) { (*sw)(t, scale, step); };
-}
 
 PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
                            const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier,
