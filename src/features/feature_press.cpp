@@ -3,6 +3,7 @@
 // operation: include/voxpress/features/flats.h.
 #include "core/timing.h"
 #include "feature_tuning.h"
+#include "smooth/curve_kernel.h"
 #include "voxpress/features/flats.h"
 
 #include <algorithm>
@@ -37,6 +38,8 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     return st;
   }
   const auto t0 = std::chrono::steady_clock::now();
+  detail::Layout layout;  // one for every press of the surface below
+  detail::make_layout(s, curves, layout);
   StickSurface est = s;
   PressOptions eo = po;
   eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
@@ -47,7 +50,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   eo.tolerance = 0;
   eo.progress = nullptr;
   eo.free_ends = false;  // see PressOptions::free_ends
-  const PressStats first_estimate = press(est, curves, eo);
+  const PressStats first_estimate = detail::press_on(est, layout, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
   // piece of a face (a couple of degrees off) can change the second
@@ -72,7 +75,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     const auto t1 = std::chrono::steady_clock::now();
     est = s;
     apply_flats(est, seg);
-    press(est, curves, eo, frozen_of(seg), seg.barrier);
+    detail::press_on(est, layout, eo, frozen_of(seg), seg.barrier);
     t_est += seconds_since(t1);
     const FlatStats before = seg.stats;
     seg = find_flats(s, curves, est.t, pass + 1 < detail::kDetectionPasses ? early : *fo);
@@ -100,7 +103,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     s.t = est.t;
     st.press = first_estimate;
   } else {
-    st.press = press(s, curves, first, frozen_of(seg), seg.barrier);
+    st.press = detail::press_on(s, layout, first, frozen_of(seg), seg.barrier);
   }
   for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
     std::vector<uint8_t> fixed;
@@ -120,7 +123,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     PressOptions again = po;
     again.iterations = rest;
     again.levels = 1;  // the fine stage goes on
-    const PressStats ps = press(s, curves, again, fixed, barrier);
+    const PressStats ps = detail::press_on(s, layout, again, fixed, barrier);
     st.press.iterations += ps.iterations;
     st.press.seconds += ps.seconds;
     st.press.residual = ps.residual;

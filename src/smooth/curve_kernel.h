@@ -247,6 +247,10 @@ struct Layout {
   Layout& operator=(const Layout&) = delete;
 };
 void make_layout(const StickSurface& s, const SliceCurves& curves, Layout& out);
+/// press() on a layout made once for the surface (make_layout), so that the
+/// presses of one run (estimates, final press, crease rounds) share it.
+PressStats press_on(StickSurface& s, const Layout& L, const PressOptions& o, const std::vector<uint8_t>& frozen = {},
+                    const std::vector<uint8_t>& barrier = {});
 
 PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
                    const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier, const PressOptions& o,

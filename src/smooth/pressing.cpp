@@ -142,13 +142,19 @@ void detail::make_layout(const StickSurface& s, const SliceCurves& curves, Layou
 
 PressStats press(StickSurface& s, const SliceCurves& curves, const PressOptions& o, const std::vector<uint8_t>& frozen,
                  const std::vector<uint8_t>& barrier) {
+  detail::Layout L;
+  detail::make_layout(s, curves, L);
+  return detail::press_on(s, L, o, frozen, barrier);
+}
+
+PressStats detail::press_on(StickSurface& s, const Layout& L, const PressOptions& o, const std::vector<uint8_t>& frozen,
+                            const std::vector<uint8_t>& barrier) {
   const size_t n = s.stick_count();
+  if (L.old_of.size() != n) throw std::invalid_argument("press: the layout does not match the sticks");
   if (!frozen.empty() && frozen.size() != n) throw std::invalid_argument("press: frozen flags do not match the sticks");
   if (!barrier.empty() && barrier.size() != n) throw std::invalid_argument("press: barrier flags do not match the sticks");
   for (size_t i = 0; i < barrier.size(); ++i)
     if (barrier[i] && (frozen.empty() || !frozen[i])) throw std::invalid_argument("press: a barrier vertex must be frozen");
-  detail::Layout L;
-  detail::make_layout(s, curves, L);
   std::vector<double> t(n);
   std::vector<uint8_t> fz(frozen.empty() ? 0 : n), br(barrier.empty() ? 0 : n);
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
