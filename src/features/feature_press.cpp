@@ -26,6 +26,83 @@ void apply_flats(StickSurface& s, const FlatSegmentation& f) {
   }
 }
 
+namespace {
+
+std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
+  std::vector<uint8_t> frozen(f.region.size());
+  for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
+  return frozen;
+}
+
+// The flats of a surface from its estimates (Section 4, last paragraph):
+// press a copy, detect, and (beyond the paper) press again with the first
+// flats frozen and detect from scratch. `est` ends as the last estimate;
+// `plain` tells whether it is still the plain press of the surface (no
+// flats were frozen in it), with `first` its stats.
+struct Segmented {
+  FlatSegmentation seg;
+  StickSurface est;
+  PressStats first;
+  bool plain = true;
+};
+
+Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail::Layout& layout,
+                  const PressOptions& po, const FlatOptions& fo) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Segmented g;
+  g.est = s;
+  PressOptions eo = po;
+  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
+  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
+  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
+  // that no plane merges back).
+  eo.levels = 2;
+  eo.tolerance = 0;
+  eo.progress = nullptr;
+  eo.free_ends = false;  // see PressOptions::free_ends
+  g.first = detail::press_on(g.est, layout, eo);
+  double t_est = seconds_since(t0);
+  // The crease refit serves the final planes only: refitting a first pass's
+  // piece of a face (a couple of degrees off) can change the second
+  // estimate enough to lose that face.
+  FlatOptions early = fo;
+  early.passes.disable(Pass::crease_refit);
+  FlatSegmentation& seg = g.seg;
+  seg = find_flats(s, curves, g.est.t, detail::kDetectionPasses > 1 ? early : fo);
+  // Beyond the paper: a second pass. The estimate of a face next to rounded
+  // edges is a pillow whose normals spread past the acceptance test (64^3
+  // boxes, thin plates). Pressed again with the first pass's flats frozen,
+  // their edges are sharp and the faces between them flat, so the second
+  // detection (from scratch, on the new estimate) finds the faces the
+  // first missed. Box 64, seeds 1-30: 162 -> 177 of 180 faces.
+  for (int pass = 1; pass < detail::kDetectionPasses && !seg.flats.empty(); ++pass) {
+    g.plain = false;
+    const auto t1 = std::chrono::steady_clock::now();
+    g.est = s;
+    apply_flats(g.est, seg);
+    PressOptions again = eo;
+    again.iterations = detail::kSecondEstimateIterations;
+    detail::press_on(g.est, layout, again, frozen_of(seg), seg.barrier);
+    t_est += seconds_since(t1);
+    const FlatStats before = seg.stats;
+    seg = find_flats(s, curves, g.est.t, pass + 1 < detail::kDetectionPasses ? early : fo);
+    seg.stats.seconds_detect += before.seconds_detect;
+    seg.stats.seconds_junctions += before.seconds_junctions;
+    for (size_t p = 0; p < size_t(Pass::count); ++p) seg.stats.passes.seconds[p] += before.passes.seconds[p];
+  }
+  seg.stats.seconds_estimate = t_est;
+  return g;
+}
+
+}  // namespace
+
+FlatSegmentation segment_flats(const StickSurface& s, const SliceCurves& curves, const PressOptions& po,
+                               const FlatOptions& fo) {
+  detail::Layout layout;
+  detail::make_layout(s, curves, layout);
+  return segment(s, curves, layout, po, fo).seg;
+}
+
 FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
                                    const FlatOptions* fo, FlatSegmentation* out) {
   FeaturePressStats st;
@@ -37,53 +114,16 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     }
     return st;
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  detail::Layout layout;  // one for every press of the surface below
+  detail::Layout layout;  // one for every press of the surface
   detail::make_layout(s, curves, layout);
-  StickSurface est = s;
-  PressOptions eo = po;
-  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
-  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
-  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
-  // that no plane merges back).
+  Segmented g = segment(s, curves, layout, po, *fo);
+  FlatSegmentation& seg = g.seg;
+  const PressStats& first_estimate = g.first;
+  const StickSurface& est = g.est;
+  const bool est_is_plain = g.plain;
+  PressOptions eo = po;  // the first estimate's schedule
+  eo.iterations = detail::kEstimateIterations;
   eo.levels = 2;
-  eo.tolerance = 0;
-  eo.progress = nullptr;
-  eo.free_ends = false;  // see PressOptions::free_ends
-  const PressStats first_estimate = detail::press_on(est, layout, eo);
-  double t_est = seconds_since(t0);
-  // The crease refit serves the final planes only: refitting a first pass's
-  // piece of a face (a couple of degrees off) can change the second
-  // estimate enough to lose that face.
-  FlatOptions early = *fo;
-  early.passes.disable(Pass::crease_refit);
-  FlatSegmentation seg = find_flats(s, curves, est.t, detail::kDetectionPasses > 1 ? early : *fo);
-  // Beyond the paper: a second pass. The estimate of a face next to rounded
-  // edges is a pillow whose normals spread past the acceptance test (64^3
-  // boxes, thin plates). Pressed again with the first pass's flats frozen,
-  // their edges are sharp and the faces between them flat, so the second
-  // detection (from scratch, on the new estimate) finds the faces the
-  // first missed. Box 64, seeds 1-30: 162 -> 177 of 180 faces.
-  auto frozen_of = [](const FlatSegmentation& f) {
-    std::vector<uint8_t> frozen(f.region.size());
-    for (size_t v = 0; v < frozen.size(); ++v) frozen[v] = f.region[v] >= 0;
-    return frozen;
-  };
-  bool est_is_plain = true;  // est is still the plain press of s (no pass froze flats in it)
-  for (int pass = 1; pass < detail::kDetectionPasses && !seg.flats.empty(); ++pass) {
-    est_is_plain = false;
-    const auto t1 = std::chrono::steady_clock::now();
-    est = s;
-    apply_flats(est, seg);
-    detail::press_on(est, layout, eo, frozen_of(seg), seg.barrier);
-    t_est += seconds_since(t1);
-    const FlatStats before = seg.stats;
-    seg = find_flats(s, curves, est.t, pass + 1 < detail::kDetectionPasses ? early : *fo);
-    seg.stats.seconds_detect += before.seconds_detect;
-    seg.stats.seconds_junctions += before.seconds_junctions;
-    for (size_t p = 0; p < size_t(Pass::count); ++p) seg.stats.passes.seconds[p] += before.passes.seconds[p];
-  }
-  seg.stats.seconds_estimate = t_est;
   apply_flats(s, seg);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
   // by the curved side's fit (fit_creases), and those of creases between

@@ -59,8 +59,10 @@ SharedFlats find_shared_flats(const LabelMasks& masks, const SharedSurface& s, c
     const std::array<int64_t, 3> lo = detail::mask_origin(label.lo);
     StickSurface surface = extract_sticks(mask);
     const SliceCurves curves = build_slice_curves(surface);
-    FlatSegmentation seg;
-    press_with_flats(surface, curves, po, &fo, &seg);
+    // Only the flats' vertices are kept: their t (on their planes) and
+    // barriers; the final press of the label's own surface would be unused.
+    FlatSegmentation seg = segment_flats(surface, curves, po, fo);
+    apply_flats(surface, seg);
     LabelFlats& lf = per[i];
     lf.flats = seg.flats;
     const bool has_flats = !seg.flats.empty();

@@ -165,6 +165,12 @@ struct FeaturePressStats {
   PassTimes passes;  ///< flats, crease_fit and curved_creases (press time), with their counts
 };
 
+/// The flats and junctions of `surface` from its estimates (the first half
+/// of press_with_flats: press a copy, detect, press again with the flats
+/// frozen, detect); the surface is not changed.
+FlatSegmentation segment_flats(const StickSurface& surface, const SliceCurves& curves, const PressOptions& options,
+                               const FlatOptions& flat_options);
+
 /// The whole Pressing pipeline: estimate (press a copy), find flats and
 /// junctions, freeze, press the fresh vertices with barriers. Without flats
 /// (flat_options == nullptr) it is press() alone. `segmentation` (optional)
