@@ -583,9 +583,7 @@ struct Sharpener {
     }
   }
 
-  // Beyond the paper: a chain whose samples allow a rounding the lattice resolves stays
-  // round; the rim pockets' slides wait for it (theory: sharpen_chains.cpp).
-  void judge_chains();
+  void judge_chains();  // beyond the paper: resolved fillets stay round (sharpen_chains.cpp)
   std::vector<std::pair<uint32_t, Vec3>> pocket_slides;  // slid rim pockets and where they were
 
   // Section 5, last paragraph: the new vertices form chains along the new
