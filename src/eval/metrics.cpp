@@ -334,6 +334,8 @@ EvalReport evaluate(const Mesh& result, const Truth& truth, const EvalOptions& o
     }
   } else if (vol && !true_sharp.empty()) {
     r.sharp_recall = 0;  // nothing labelled: none of the true curves is found
+  } else if (vol && !result.edges.empty()) {
+    r.sharp_precision = 0;  // labelled curves on a truth without any: none of their length is real
   }
 
   MeshCheckOptions mo;

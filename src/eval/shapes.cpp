@@ -49,7 +49,12 @@ ShapeKind parse_shape(std::string_view name) {
   throw UsageError("unknown shape '" + std::string(name) + "' (choose sphere, torus, box, cylinder or cad-part)");
 }
 
-bool shape_contains(ShapeKind kind, const Vec3& m) {
+bool shape_contains(ShapeKind kind, const Vec3& m, double fillet) {
+  if (kind == ShapeKind::box && fillet > 0) {
+    // The Minkowski sum of the shrunk box and a ball: within `fillet` of it.
+    const Vec3 inner = kBoxHalf - Vec3::Constant(fillet);
+    return (m.cwiseAbs() - inner).cwiseMax(0.0).squaredNorm() <= fillet * fillet;
+  }
   switch (kind) {
     case ShapeKind::sphere: return m.squaredNorm() <= 1.0;
     case ShapeKind::torus: {
@@ -78,8 +83,16 @@ double shape_support(ShapeKind kind, const Vec3& d) {
   }
 }
 
-double shape_volume(ShapeKind kind) {
+double shape_volume(ShapeKind kind, double fillet) {
   const double pi = std::numbers::pi;
+  if (kind == ShapeKind::box && fillet > 0) {
+    // Steiner's formula for the shrunk box h plus a ball of radius f: volume,
+    // + area f, + the edges' quarter cylinders, + the corners' ball.
+    const Vec3 h = kBoxHalf - Vec3::Constant(fillet);
+    const double f = fillet;
+    return 8 * h.prod() + 8 * (h.x() * h.y() + h.y() * h.z() + h.x() * h.z()) * f + 2 * pi * h.sum() * f * f +
+           4.0 / 3.0 * pi * f * f * f;
+  }
   switch (kind) {
     case ShapeKind::sphere: return 4.0 / 3.0 * pi;
     case ShapeKind::torus: return 2 * pi * pi * kTorusMajor * kTorusMinor * kTorusMinor;
@@ -98,9 +111,9 @@ double shape_volume(ShapeKind kind) {
       const double f = 0.1;
       const double a = f * f * (1 - pi / 4);
       const double xc = f * (10 - 3 * pi) / (12 - 3 * pi);
-      const double fillet = 2 * pi * (0.35 + xc) * a;
+      const double ring = 2 * pi * (0.35 + xc) * a;
       const double hole = pi * 0.18 * 0.18 * 0.5;
-      return plate - chamfer + boss + fillet - hole;
+      return plate - chamfer + boss + ring - hole;
     }
   }
 }
@@ -148,6 +161,8 @@ Mat3 parse_rotation(const std::string& spec) {
 
 GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
   const Mat3& R = o.rotation;
+  if (!(o.fillet >= 0) || !std::isfinite(o.fillet)) throw UsageError("--fillet must be a finite radius >= 0");
+  if (o.fillet > 0 && kind != ShapeKind::box) throw UsageError("--fillet rounds the box's edges: use it with 'box'");
   // Extent of the rotated shape along each world axis: support in +/- e_a.
   Vec3 lo, hi;
   for (int a = 0; a < 3; ++a) {
@@ -162,6 +177,12 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
   g.linear = place.linear;
   g.translation = place.translation;
   const Lattice& L = place.lattice;
+  // The radius in cells of the smallest spacing, in model units; the
+  // lattice is the sharp box's (the rounded box lies inside it).
+  g.fillet = o.fillet * L.spacing.minCoeff() / g.scale;
+  if (g.fillet >= kBoxHalf.minCoeff())
+    throw UsageError("--fillet " + std::to_string(o.fillet) + " cells is not below the box's smallest half extent (" +
+                     std::to_string(kBoxHalf.minCoeff() * g.scale / L.spacing.minCoeff()) + " cells)");
   if (kind == ShapeKind::cad_part) {
     // The part is its mesh: classify every sample exactly against it.
     Mesh physical;
@@ -177,12 +198,12 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
       for (int64_t j = 0; j < L.dims[1]; ++j)
         for (int64_t i = 0; i < L.dims[0]; ++i) {
           const Vec3 p = L.to_physical(Vec3(double(i), double(j), double(k)));
-          g.volume.inside[L.linear(i, j, k)] = shape_contains(kind, to_model * (p - g.translation)) ? 1 : 0;
+          g.volume.inside[L.linear(i, j, k)] = shape_contains(kind, to_model * (p - g.translation), g.fillet) ? 1 : 0;
         }
       progress.add(1);
     });
   }
-  g.volume.source = std::string("generated ") + shape_name(kind);
+  g.volume.source = std::string("generated ") + shape_name(kind) + (g.fillet > 0 ? " (filleted)" : "");
   return g;
 }
 
@@ -238,16 +259,16 @@ std::vector<PlanarFace> planar_faces(const Mesh& mesh, double angle_deg, double 
   return out;
 }
 
-std::vector<PlanarFace> shape_planar_faces(ShapeKind kind) {
+std::vector<PlanarFace> shape_planar_faces(ShapeKind kind, double fillet) {
   std::vector<PlanarFace> out;
   switch (kind) {
     case ShapeKind::box: {
-      const Vec3 h = kBoxHalf;
+      const Vec3 h = kBoxHalf, inner = kBoxHalf - Vec3::Constant(fillet);  // a filleted face is its inner rectangle
       for (int a = 0; a < 3; ++a)
         for (double s : {1.0, -1.0}) {
           Vec3 n = Vec3::Zero();
           n[a] = s;
-          out.push_back({n, h[a], 4 * h[(a + 1) % 3] * h[(a + 2) % 3]});
+          out.push_back({n, h[a], 4 * inner[(a + 1) % 3] * inner[(a + 2) % 3]});
         }
       break;
     }

@@ -25,11 +25,15 @@ constexpr double kCylR = 0.6, kCylH = 1.0;
 // ------------------------------------------------------------- analytic
 class AnalyticTruth final : public Truth {
  public:
-  AnalyticTruth(ShapeKind kind, const Mat3& linear, const Vec3& translation)
+  AnalyticTruth(ShapeKind kind, const Mat3& linear, const Vec3& translation, double fillet)
       : kind_(kind), A_(linear), t_(translation), Ainv_(linear.inverse()), N_(linear.inverse().transpose()),
-        scale_(std::cbrt(std::abs(linear.determinant()))) {}
+        scale_(std::cbrt(std::abs(linear.determinant()))), fillet_(kind == ShapeKind::box ? fillet : 0) {}
 
-  std::string describe() const override { return std::string(shape_name(kind_)) + " (analytic)"; }
+  std::string describe() const override {
+    std::string d = std::string(shape_name(kind_)) + " (analytic";
+    if (fillet_ > 0) d += ", edges filleted, radius " + std::to_string(fillet_ * scale_) + " physical";
+    return d + ")";
+  }
 
   SurfacePoint closest(const Vec3& p, const Vec3* normal_hint) const override {
     const Vec3 m = Ainv_ * (p - t_);
@@ -40,7 +44,7 @@ class AnalyticTruth final : public Truth {
     return {t_ + A_ * q, (N_ * n).normalized()};
   }
 
-  bool contains(const Vec3& p) const override { return shape_contains(kind_, Ainv_ * (p - t_)); }
+  bool contains(const Vec3& p) const override { return shape_contains(kind_, Ainv_ * (p - t_), fillet_); }
 
   double crossing(const Vec3& a, const Vec3& b, double near) const override {
     // Bisection on the exact inside test. A one-voxel stick crosses these
@@ -70,6 +74,10 @@ class AnalyticTruth final : public Truth {
   SurfacePoint sample(uint64_t seed, uint64_t index) const override {
     auto u = [&](int k) { return detail::uniform(seed, 8 * index + uint64_t(k)); };
     Vec3 q, n;
+    if (fillet_ > 0) {
+      sample_filleted_box(u, q, n);
+      return {t_ + A_ * q, (N_ * n).normalized()};
+    }
     switch (kind_) {
       case ShapeKind::sphere: {
         const double z = 2 * u(0) - 1, phi = 2 * kPi * u(1), r = std::sqrt(std::max(0.0, 1 - z * z));
@@ -130,17 +138,23 @@ class AnalyticTruth final : public Truth {
     switch (kind_) {
       case ShapeKind::sphere: a = 4 * kPi; break;
       case ShapeKind::torus: a = 4 * kPi * kPi * kTorusR * kTorusr; break;
-      case ShapeKind::box: a = 8 * (kBoxHalf.x() * kBoxHalf.y() + kBoxHalf.y() * kBoxHalf.z() + kBoxHalf.x() * kBoxHalf.z()); break;
+      case ShapeKind::box: {
+        // Faces of the shrunk box, the edges' quarter cylinders, the corners' ball.
+        const Vec3 h = kBoxHalf - Vec3::Constant(fillet_);
+        const double f = fillet_;
+        a = 8 * (h.x() * h.y() + h.y() * h.z() + h.x() * h.z()) + 4 * kPi * f * h.sum() + 4 * kPi * f * f;
+        break;
+      }
       default: a = 2 * kPi * kCylR * 2 * kCylH + 2 * kPi * kCylR * kCylR; break;
     }
     return a * scale_ * scale_;
   }
-  double volume() const override { return shape_volume(kind_) * std::abs(A_.determinant()); }
+  double volume() const override { return shape_volume(kind_, fillet_) * std::abs(A_.determinant()); }
 
   std::vector<std::array<Vec3, 2>> sharp_edges(double angle_deg) const override {
     std::vector<std::array<Vec3, 2>> out;
     auto add = [&](const Vec3& a, const Vec3& b) { out.push_back({t_ + A_ * a, t_ + A_ * b}); };
-    if (kind_ == ShapeKind::box && angle_deg < 90) {
+    if (kind_ == ShapeKind::box && fillet_ == 0 && angle_deg < 90) {  // a filleted box is C1: none
       const Vec3& h = kBoxHalf;
       for (int axis = 0; axis < 3; ++axis)
         for (int s1 : {-1, 1})
@@ -175,8 +189,78 @@ class AnalyticTruth final : public Truth {
     return candidates[best];
   }
 
+  // The filleted box (the shrunk box h plus a ball of radius f), uniform by
+  // area: a face of the shrunk box, an edge's quarter cylinder or a corner's
+  // ball eighth, by their areas. A uniform direction of the whole ball
+  // (cylinder) lands in the corner (edge) of its signs.
+  template <class U>
+  void sample_filleted_box(const U& u, Vec3& q, Vec3& n) const {
+    const Vec3 h = kBoxHalf - Vec3::Constant(fillet_);
+    const double f = fillet_;
+    double piece[7];
+    for (int a = 0; a < 3; ++a) {
+      piece[a] = 8 * h[(a + 1) % 3] * h[(a + 2) % 3];  // the two faces normal to axis a
+      piece[3 + a] = 4 * kPi * f * h[a];                // the four edges along axis a
+    }
+    piece[6] = 4 * kPi * f * f;
+    double total = 0;
+    for (double p : piece) total += p;
+    double pick = u(0) * total;
+    int k = 0;
+    while (k < 6 && pick > piece[k]) pick -= piece[k++];
+    auto sgn = [](double x) { return x >= 0 ? 1.0 : -1.0; };
+    if (k < 3) {  // a face
+      const int a1 = (k + 1) % 3, a2 = (k + 2) % 3;
+      n = Vec3::Zero();
+      n[k] = u(1) < 0.5 ? -1 : 1;
+      q = h[k] * n + f * n;
+      q[a1] = (2 * u(2) - 1) * h[a1];
+      q[a2] = (2 * u(3) - 1) * h[a2];
+    } else if (k < 6) {  // an edge along axis a
+      const int a = k - 3, a1 = (a + 1) % 3, a2 = (a + 2) % 3;
+      const double phi = 2 * kPi * u(1);
+      n = Vec3::Zero();
+      n[a1] = std::cos(phi);
+      n[a2] = std::sin(phi);
+      Vec3 c = Vec3::Zero();
+      c[a] = (2 * u(2) - 1) * h[a];
+      c[a1] = sgn(n[a1]) * h[a1];
+      c[a2] = sgn(n[a2]) * h[a2];
+      q = c + f * n;
+    } else {  // a corner
+      const double z = 2 * u(1) - 1, phi = 2 * kPi * u(2), r = std::sqrt(std::max(0.0, 1 - z * z));
+      n = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+      q = Vec3(sgn(n.x()) * h.x(), sgn(n.y()) * h.y(), sgn(n.z()) * h.z()) + f * n;
+    }
+  }
+
+  // The filleted box's exact closest point: from outside the shrunk box h,
+  // along the direction from its nearest point c (distance |m - c| - f);
+  // from inside it, straight to the nearest face (its flat part covers the
+  // projection). The surface is C1, so the normal is unique.
+  void closest_filleted_box(const Vec3& m, Vec3& q, Vec3& n) const {
+    const Vec3 h = kBoxHalf - Vec3::Constant(fillet_);
+    const Vec3 c = m.cwiseMax(-h).cwiseMin(h);
+    const Vec3 d = m - c;
+    if (d.squaredNorm() > 0) {
+      n = d.normalized();
+    } else {
+      int axis = 0;
+      for (int a = 1; a < 3; ++a)
+        if (h[a] - std::abs(m[a]) < h[axis] - std::abs(m[axis])) axis = a;
+      n = Vec3::Zero();
+      n[axis] = m[axis] >= 0 ? 1 : -1;
+      Vec3 cc = m;
+      cc[axis] = n[axis] * h[axis];
+      q = cc + fillet_ * n;
+      return;
+    }
+    q = c + fillet_ * n;
+  }
+
   // Exact closest point q on the model surface and outward normal n.
   void closest_model(const Vec3& m, const Vec3& hint, Vec3& q, Vec3& n) const {
+    if (fillet_ > 0) return closest_filleted_box(m, q, n);
     switch (kind_) {
       case ShapeKind::sphere: {
         const double r = m.norm();
@@ -259,6 +343,7 @@ class AnalyticTruth final : public Truth {
   Vec3 t_;
   Mat3 Ainv_, N_;
   double scale_;
+  double fillet_;  // the box's fillet radius (model units), 0 otherwise
 };
 
 // ------------------------------------------------------------- mesh
@@ -323,10 +408,10 @@ Mesh transformed(const Mesh& m, const Mat3& linear, const Vec3& translation) {
 
 }  // namespace
 
-std::unique_ptr<Truth> shape_truth(ShapeKind kind, const Mat3& linear, const Vec3& translation) {
+std::unique_ptr<Truth> shape_truth(ShapeKind kind, const Mat3& linear, const Vec3& translation, double fillet) {
   if (kind == ShapeKind::cad_part)
     return mesh_truth(transformed(cad_part_mesh(), linear, translation), shape_name(kind));
-  return std::make_unique<AnalyticTruth>(kind, linear, translation);
+  return std::make_unique<AnalyticTruth>(kind, linear, translation, fillet);
 }
 
 std::unique_ptr<Truth> mesh_truth(Mesh physical_mesh, const std::string& name) {
@@ -358,6 +443,7 @@ std::unique_ptr<Truth> resolve_truth(const std::string& spec, const ScalarVolume
   Vec3 translation = Vec3::Zero();
   bool have_transform = false;
   std::string meta_shape, meta_mesh;
+  double fillet = 0;
   if (volume) {
     auto get = [&](const char* key) {
       auto it = volume->metadata.find(key);
@@ -371,6 +457,13 @@ std::unique_ptr<Truth> resolve_truth(const std::string& spec, const ScalarVolume
         throw InputError(volume->source, std::string("malformed ") + kModelToPhysicalKey + " metadata");
       have_transform = true;
     }
+    const std::string fl = get(kFilletKey);
+    if (!fl.empty()) {
+      char* end = nullptr;
+      fillet = std::strtod(fl.c_str(), &end);
+      if (end == fl.c_str() || *end != '\0' || !(fillet >= 0) || !std::isfinite(fillet))
+        throw InputError(volume->source, std::string("malformed ") + kFilletKey + " metadata");
+    }
   }
   std::string what = spec.empty() ? (!meta_shape.empty() ? meta_shape : meta_mesh) : spec;
   if (what.empty())
@@ -381,7 +474,7 @@ std::unique_ptr<Truth> resolve_truth(const std::string& spec, const ScalarVolume
       if (!have_transform)
         throw UsageError(std::string("the ") + shape_name(k) +
                          " truth needs its placement: give the --volume written by `voxpress generate`");
-      return shape_truth(k, linear, translation);
+      return shape_truth(k, linear, translation, fillet);
     }
   // A mesh file: the stored transform applies when the volume was voxelized from a model.
   Mesh model = read_mesh(what);

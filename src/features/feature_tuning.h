@@ -43,5 +43,8 @@ constexpr int kFinalCreaseRings = 2;       // as kCreaseRings, once the regions 
 constexpr int kFinalCreaseFitRings = 5;    // as kCreaseFitRings
 constexpr double kFinalCreaseResidual = 0.04;  // as kCreaseResidual
 constexpr double kFinalCreaseMaxMove = 0.3;    // cells along the stick: the final placement only corrects
+// --- round chains (Section 5's chains; sharpen_chains.cpp): a chain stays round when its samples allow
+constexpr double kRoundRadius = 0.85;   // cells: ... a fillet this large (build/bench/bench_fillets: sharp edges allow <= 0.46, r = 0.5 <= 0.69, r = 1 >= 1.0)
+constexpr double kRoundEvidence = 0.15;  // cells: ... and demand one: a sample this deep inside both planes (bench_fillets r = 1: >= 0.23; bench_compare --quick: sharp CAD <= 0.14)
 
 }  // namespace voxpress::detail

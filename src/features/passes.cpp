@@ -41,6 +41,8 @@ const std::vector<PassInfo>& feature_passes() {
       {Pass::inherit_junctions, "inherit-junctions", "beyond the paper",
        "the neighbours of a junction that joined a flat become junctions"},
       {Pass::sample_wedges, "sample-wedges", "beyond the paper", "a chamfer's two planes agree with its samples"},
+      {Pass::round_chains, "round-chains", "beyond the paper (Section 5's chains)",
+       "a crease chain whose samples allow a fillet the lattice resolves stays round (issue 75)"},
   };
   return passes;
 }

@@ -36,8 +36,11 @@ SharpenResult Sharpener::run() {
     std::iota(parent.begin(), parent.end(), 0u);
   }
   if (!nv.empty()) {
-    index();
     build_chains();
+    const auto t = std::chrono::steady_clock::now();
+    judge_chains();  // before index(): it may slide rim pockets
+    st.passes.add(Pass::round_chains, std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
+    index();
     spread_targets();
     // The moves, in order: leftovers onto their flat, edge vertices onto
     // their crease, then corners (Section 5). A move blocked by a
@@ -88,6 +91,7 @@ SharpenResult Sharpener::run() {
   st.passes.count[size_t(Pass::curved_creases)] += st.curved_crease_vertices;
   st.passes.count[size_t(Pass::tangent_planes)] = st.tangent_planes;
   st.passes.count[size_t(Pass::sample_wedges)] = st.wedge_shifts;
+  st.passes.count[size_t(Pass::round_chains)] = st.round_chains;
   st.passes.count[size_t(Pass::sharpen)] = st.inserted;
   st.sharp_edges = r.mesh.edges.size();
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -188,6 +188,7 @@ void Sharpener::join_leftovers() {
         pocket.push_back(v);
         continue;
       }
+      pocket_slides.push_back({v, x[v]});  // judge_chains takes it back beside a chain left round
       slide(v, t);
     }
     label[v] = f;

@@ -39,11 +39,9 @@ constexpr double kPi = std::numbers::pi;
 constexpr int kBucket = 2;       // cells per side of the buckets of the local intersection test
 constexpr int kNearBlock = 4;    // cells per side of the blocks that decide which triangles it sees
 constexpr int kBisections = 8;   // steps when a move is cut back
-// A new vertex on a crease between two curved faces moves at most this far
-// (cells): their tangent planes are fitted, not detected, and on the
-// bunny's false creases their line lay up to 2 cells off (result -> truth
-// max 0.72 -> 1.49 at 128^3). 0.5: bunny 128 / 256 0.1221 / 0.1006 ->
-// 0.1166 / 0.0995, fandisk 128 seeds 1-4 unchanged (0.0592 / 0.0590).
+// Cells: a new vertex on a crease between two curved faces moves at most
+// this far (their tangent planes are fitted, not detected; the bunny's false
+// creases lay up to 2 cells off: build/bench/bench_compare, bunny.off).
 constexpr double kCurvedCreaseMove = 0.5;
 constexpr int kRounds = 8;       // passes over the new vertices' moves (then up to as many cutting back)
 constexpr double kAdvance = 1e-3;  // cells: a cut-back round where no vertex advances more is the last
@@ -584,6 +582,9 @@ struct Sharpener {
       for (uint32_t i = 0; i < nv.size(); ++i) nv[i].target = next[i];
     }
   }
+
+  void judge_chains();  // beyond the paper: resolved fillets stay round (sharpen_chains.cpp)
+  std::vector<std::pair<uint32_t, Vec3>> pocket_slides;  // slid rim pockets and where they were
 
   // Section 5, last paragraph: the new vertices form chains along the new
   // edges; chain vertices (not ends, not corners) are smoothed with a

@@ -380,6 +380,21 @@ TEST(Cli, VoxelizeExtractEvalPipeline) {
   const double sampled = b["voxels"]["result_to_truth"]["rms"].get<double>();
   EXPECT_NEAR(b["voxels"]["result_to_truth_rule_rms"].get<double>(), sampled, 0.03 * sampled);
   EXPECT_FALSE(e["voxels"].contains("result_to_truth_rule_rms"));  // not asked for
+  // The box with its edges rounded (2 cells): the volume carries the radius,
+  // so `eval` measures against the rounded truth, which has no sharp edge.
+  ASSERT_EQ(run_cli("-q generate box --res 48 --rotate random:4 --fillet 2 -o " + tmp.path("f.nrrd"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("f.nrrd") + " -o " + tmp.path("f.ply"), &out), 0);
+  ASSERT_EQ(run_cli("-q eval " + tmp.path("f.ply") + " --volume " + tmp.path("f.nrrd") + " --samples 20000 --json " +
+                        tmp.path("f.json"),
+                    &out),
+            0)
+      << out;
+  const auto f = nlohmann::json::parse(std::ifstream(tmp.path("f.json")));
+  EXPECT_NE(f["truth"].get<std::string>().find("filleted"), std::string::npos);
+  EXPECT_EQ(f["true_sharp_edge_segments"], 0);
+  EXPECT_NEAR(f["volume_ratio"].get<double>(), 1.0, 0.02);  // the rounded truth is what was sampled
+  EXPECT_LT(f["voxels"]["result_to_truth"]["rms"].get<double>(), 0.3);
+  EXPECT_EQ(run_cli("-q generate sphere --res 32 --fillet 1 -o " + tmp.path("s.nrrd"), &out), 2);
   // Errors: an open model, a truth nobody can place, a missing result.
   Mesh open = cad_part_mesh();
   open.triangles.resize(open.triangles.size() - 2);

@@ -236,6 +236,20 @@ TEST(Metrics, SharpRecallAndPrecisionMeasureLength) {
   ASSERT_TRUE(none.sharp_recall);
   EXPECT_EQ(*none.sharp_recall, 0.0);
   EXPECT_FALSE(none.sharp_precision);
+  // The same labels on a truth without sharp edges (the box rounded by 2
+  // cells, issue 75): nothing to find, and none of the labelled length is real.
+  Mesh m = plain;
+  m.positions.push_back(edges[0][0]);
+  m.positions.push_back(edges[0][1]);
+  m.edges.push_back({uint32_t(m.positions.size() - 2), uint32_t(m.positions.size() - 1)});
+  EvalOptions eo;
+  eo.samples = 2000;
+  eo.volume = &g.volume;
+  eo.self_intersections = false;
+  const EvalReport rounded = evaluate(m, *shape_truth(ShapeKind::box, g.linear, g.translation, 2 / g.scale), eo);
+  EXPECT_FALSE(rounded.sharp_recall);
+  ASSERT_TRUE(rounded.sharp_precision);
+  EXPECT_EQ(*rounded.sharp_precision, 0.0);
 }
 
 TEST(Metrics, StickMetricIsExactForKnownParameters) {

@@ -103,6 +103,68 @@ TEST(Truth, SharpEdges) {
   EXPECT_NEAR(cad, expected, 1e-3);
 }
 
+// The filleted box (issue 75's truth-known family): its closed-form closest
+// point, area sampler, area and volume agree with each other and with the
+// generated volume; the rounded box has no sharp edge, the sharp one 12; the
+// lattice is the sharp box's and the rounded solid lies inside it; `eval`
+// finds the radius in the volume's metadata.
+TEST(Truth, FilletedBoxIsExactAndHasNoSharpEdges) {
+  test::Rng rng(5);
+  const Mat3 R = parse_rotation("random:12");
+  const double f = 0.2;  // model units (the box's half extents: 1, 0.75, 0.5)
+  const auto truth = shape_truth(ShapeKind::box, 7.5 * R, Vec3(3, -2, 40), f);
+  std::vector<Vec3> dense;
+  for (uint64_t i = 0; i < 200000; ++i) dense.push_back(truth->sample(3, i).point);
+  for (int q = 0; q < 40; ++q) {
+    const Vec3 p = Vec3(3, -2, 40) + 12 * Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
+    const SurfacePoint c = truth->closest(p);
+    double best = INFINITY;
+    for (const Vec3& d : dense) best = std::min(best, (d - p).norm());
+    const double exact = (c.point - p).norm();
+    EXPECT_LE(exact, best + 1e-9);
+    EXPECT_GE(exact, best - 0.08);
+    EXPECT_TRUE(truth->contains(c.point - 1e-6 * c.normal));
+    EXPECT_FALSE(truth->contains(c.point + 1e-6 * c.normal));
+  }
+  // Area: the sharp box's minus what rounding takes (Steiner), as the sampler's pieces add up.
+  const double pi = std::numbers::pi, s2 = 7.5 * 7.5;
+  const Vec3 h = Vec3(1, 0.75, 0.5) - Vec3::Constant(f);
+  EXPECT_NEAR(truth->area(), s2 * (8 * (h.x() * h.y() + h.y() * h.z() + h.x() * h.z()) + 4 * pi * f * h.sum() + 4 * pi * f * f),
+              1e-9);
+  EXPECT_TRUE(truth->sharp_edges(30).empty());
+  EXPECT_EQ(shape_truth(ShapeKind::box, 7.5 * R, Vec3(3, -2, 40), 0)->sharp_edges(30).size(), 12u);
+  // Generated with a radius in cells: the same lattice as the sharp box, a
+  // subset of its samples, and the closed-form volume.
+  GenerateOptions o;
+  o.res = 48;
+  o.rotation = parse_rotation("random:4");
+  const GeneratedShape sharp = generate_shape(ShapeKind::box, o);
+  o.fillet = 4;
+  const GeneratedShape round = generate_shape(ShapeKind::box, o);
+  EXPECT_EQ(round.volume.lattice.dims, sharp.volume.lattice.dims);
+  EXPECT_NEAR(round.fillet * round.scale, 4.0, 1e-12);
+  size_t outside_sharp = 0;
+  for (size_t i = 0; i < sharp.volume.inside.size(); ++i) outside_sharp += round.volume.inside[i] && !sharp.volume.inside[i];
+  EXPECT_EQ(outside_sharp, 0u);
+  EXPECT_LT(round.volume.count_inside(), sharp.volume.count_inside());
+  const double exact = shape_volume(ShapeKind::box, round.fillet) * std::pow(round.scale, 3);
+  EXPECT_NEAR(double(round.volume.count_inside()) / exact, 1.0, 0.01);
+  EXPECT_NEAR(shape_truth(ShapeKind::box, round.linear, round.translation, round.fillet)->volume(), exact, 1e-9 * exact);
+  o.fillet = 20;  // beyond the smallest half extent
+  EXPECT_THROW(generate_shape(ShapeKind::box, o), UsageError);
+  o.fillet = 1;
+  EXPECT_THROW(generate_shape(ShapeKind::sphere, o), UsageError);
+  // From the volume's metadata, as `eval` reads it.
+  ScalarVolume v;
+  v.source = "box.nrrd";
+  v.metadata[kShapeKey] = "box";
+  v.metadata[kModelToPhysicalKey] = format_transform(round.linear, round.translation);
+  v.metadata[kFilletKey] = std::to_string(round.fillet);
+  EXPECT_TRUE(resolve_truth("", &v)->sharp_edges(30).empty());
+  v.metadata[kFilletKey] = "x";
+  EXPECT_THROW(resolve_truth("", &v), InputError);
+}
+
 TEST(Truth, ResolveFromVolumeMetadata) {
   ScalarVolume v;
   v.source = "vol.nrrd";

@@ -79,7 +79,8 @@ struct EvalReport {
   std::optional<double> sharp_true_to_labelled_vox, sharp_labelled_to_true_vox, sharp_edge_hausdorff_vox;
   /// With the volume: the share of the true sharp curves' length within
   /// sharp_match_vox voxels of a labelled curve (recall), and of the
-  /// labelled curves' length within as much of a true one (precision).
+  /// labelled curves' length within as much of a true one (precision; 0
+  /// when the truth has none and some are labelled).
   /// The Hausdorff distance is one worst point; these say how much of the
   /// feature network is found, and how much of what is labelled is real.
   std::optional<double> sharp_recall, sharp_precision;

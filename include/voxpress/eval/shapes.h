@@ -38,7 +38,10 @@ std::vector<ShapeKind> all_shapes();
 ///            cylindrical boss (radius 0.35) with a concave fillet (radius
 ///            0.1) at its base, and a through hole (radius 0.18); defined by
 ///            its exact boundary mesh, cad_part_mesh() (the test is O(#faces))
-bool shape_contains(ShapeKind kind, const Vec3& m);
+/// `fillet` (model units, box only): the box's edges and corners rounded
+/// with that radius, the Minkowski sum of the box shrunk by it and a ball
+/// (0: the sharp box; below its smallest half extent).
+bool shape_contains(ShapeKind kind, const Vec3& m, double fillet = 0);
 /// The CAD part's exact boundary representation in model units: a closed,
 /// manifold, outward triangle mesh (~0.3 M triangles; built once, ~0.1 s).
 /// It *defines* the part: shape_contains and generate_shape use it.
@@ -58,14 +61,14 @@ struct PlanarFace {
 std::vector<PlanarFace> planar_faces(const Mesh& mesh, double angle_deg = 1e-4, double distance = 1e-9);
 /// The planar faces of a shape in model units (box: 6, cylinder: its 2
 /// caps, cad-part: those of its mesh larger than 1e-3, sphere/torus: none).
-std::vector<PlanarFace> shape_planar_faces(ShapeKind kind);
+std::vector<PlanarFace> shape_planar_faces(ShapeKind kind, double fillet = 0);
 /// A plane under physical = translation + linear * model (linear a similarity).
 PlanarFace transform_face(const PlanarFace& f, const Mat3& linear, const Vec3& translation);
 /// Support function: max over the shape of m . d (d need not be unit).
 double shape_support(ShapeKind kind, const Vec3& d);
 /// Volume of the solid in model units^3 (closed form; one 1-D integral for
 /// the CAD part's chamfer across its rounded corners). Used by tests.
-double shape_volume(ShapeKind kind);
+double shape_volume(ShapeKind kind, double fillet = 0);
 
 /// Parses "random:SEED", "AX,AY,AZ" (degrees, applied about x then y then z)
 /// or "none". Random rotations are uniform over SO(3) and reproducible across
@@ -77,6 +80,10 @@ struct GenerateOptions {
   Vec3 spacing{1, 1, 1};        ///< physical cell size along i, j, k
   Mat3 rotation = Mat3::Identity();
   int64_t margin = 2;           ///< outside samples around the shape's bounding box
+  /// Box only: its edges and corners rounded with this radius in cells (the
+  /// smallest spacing). The lattice is the sharp box's, so every radius of
+  /// one rotation samples the same lattice and r = 0 is the box itself.
+  double fillet = 0;
   uint64_t max_bytes = 0;       ///< LimitError if the volume would exceed this (0 = no cap)
   Progress* progress = nullptr;
 };
@@ -88,6 +95,7 @@ struct GeneratedShape {
   Mat3 linear = Mat3::Identity();
   Vec3 translation = Vec3::Zero();
   double scale = 1;  ///< physical units per model unit
+  double fillet = 0;  ///< the box's fillet radius in model units (GenerateOptions::fillet / scale)
 };
 
 GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& options);
@@ -96,5 +104,7 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& options);
 /// model -> physical transform (12 numbers: row-major 3x3, then translation).
 inline constexpr const char* kShapeKey = "voxpress_shape";
 inline constexpr const char* kModelToPhysicalKey = "voxpress_model_to_physical";
+/// The box's fillet radius in model units (absent: 0, the sharp box).
+inline constexpr const char* kFilletKey = "voxpress_fillet";
 
 }  // namespace voxpress

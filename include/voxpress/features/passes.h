@@ -42,6 +42,7 @@ enum class Pass : uint8_t {
   past_crease,        // beyond: vertices on the wrong side of a crease change sides
   inherit_junctions,  // beyond: a curved junction that joined a flat passes the border on
   sample_wedges,      // beyond: a chamfer's two planes must agree with its sticks' samples
+  round_chains,       // beyond (Section 5's chains): a chain whose samples allow a resolved rounding stays round
   count
 };
 

@@ -36,6 +36,10 @@
 //  3. The new vertices form chains along the new edges (corners and ends
 //     fixed); the chains are smoothed with a bilaplacian, each vertex moving
 //     across its chain only and, next to a flat, within the flat's plane.
+//     Beyond the paper, each chain is first judged whole (round-chains,
+//     src/features/sharpen_chains.cpp): where its samples allow and demand
+//     a fillet the lattice resolves, its vertices stay on the chamfer and
+//     are not labelled, so a filleted edge stays round.
 //  4. Beyond the paper — the guarantee survives: every move is checked
 //     exactly before it is made. A vertex moving from p to q sweeps each
 //     incident triangle (p, a, b) through the tetrahedron (p, q, a, b); a
@@ -86,6 +90,7 @@ struct SharpenStats {
   size_t inherited_junctions = 0;     ///< curved vertices made junctions by a joined neighbour (inherit_junctions)
   size_t wedge_checks = 0;            ///< chamfer edges whose two planes' solid misplaced a sample (sample_wedge)
   size_t wedge_shifts = 0;            ///< ... of which the curved side's plane was moved onto the sample
+  size_t round_chains = 0;            ///< chains left round: their samples allow a fillet the lattice resolves
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
   PassTimes passes;                   ///< per pass (the base steps as Pass::sharpen)
