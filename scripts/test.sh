@@ -38,7 +38,10 @@ phase "sanitized build done"
 # volumes (their code runs in the suites kept, on smaller inputs); the
 # voxelizer at random rotations and the shared medical volumes' documented
 # facts (their code runs in the other Voxelize and VolumeIO tests and the
-# fuzzers). The corpus itself is smaller under the sanitizers
+# fuzzers); the filleted boxes' decision at 48^3 (39 s under ASan; the
+# round-chains pass runs in the sharpening's corpus) and the invariance
+# checks (74 s: bitwise equality of t, which the press's corpus runs under
+# the sanitizers on the same code). The corpus itself is smaller under the sanitizers
 # (tests/test_util.cpp), and the pressing corpus runs one circle correction.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndItsCreasesAreFound:Sharpen.RotatedBoxesGetTheirEdgesBack:\
@@ -62,7 +65,8 @@ Truth.SharpEdges:Shapes.SampledVolumeMatchesAnalyticVolume:Flats.JunctionAngleOp
 Sharpen.CurvedCreasesOnlyWhereTheyContinueAFlatsCrease:Pressing.ArcLengthResamplingBeatsThePlainBilaplacian:\
 Pipeline.PressingStagesAndOverridesAreHonoured:Flats.WithoutFlatsTheResultIsThePlainPress:\
 Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtRandomRotations:\
-VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts"
+VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts:Sharpen.FilletsTheLatticeResolvesStayRound:\
+Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedShapesGiveTheSameT"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.
 runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 io_tests:0:1 extract_tests:0:1
