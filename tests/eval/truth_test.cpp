@@ -8,6 +8,27 @@
 namespace voxpress {
 namespace {
 
+// The exact closest point of a shape 7.5 x its model placed at (3, -2, 40)
+// can never be farther than the nearest of many dense surface samples, nor
+// much closer; it is on the surface (inside just below, outside just above)
+// with a unit normal.
+void expect_exact_closest_points(const Truth& truth, test::Rng& rng) {
+  std::vector<Vec3> dense;
+  for (uint64_t i = 0; i < 200000; ++i) dense.push_back(truth.sample(3, i).point);
+  for (int q = 0; q < 40; ++q) {
+    const Vec3 p = Vec3(3, -2, 40) + 12 * Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
+    const SurfacePoint c = truth.closest(p);
+    double best = INFINITY;
+    for (const Vec3& d : dense) best = std::min(best, (d - p).norm());
+    const double exact = (c.point - p).norm();
+    EXPECT_LE(exact, best + 1e-9);
+    EXPECT_GE(exact, best - 0.08);  // samples are ~0.05 apart on this 7.5x shape
+    EXPECT_NEAR(c.normal.norm(), 1.0, 1e-12);
+    EXPECT_TRUE(truth.contains(c.point - 1e-6 * c.normal));
+    EXPECT_FALSE(truth.contains(c.point + 1e-6 * c.normal));
+  }
+}
+
 TEST(Truth, AnalyticClosestPointsBeatEveryDenseSample) {
   // The exact closest point can never be farther than the nearest of many
   // dense surface samples, and never much closer than them.
@@ -16,21 +37,7 @@ TEST(Truth, AnalyticClosestPointsBeatEveryDenseSample) {
   for (ShapeKind k : {ShapeKind::sphere, ShapeKind::torus, ShapeKind::box, ShapeKind::cylinder}) {
     SCOPED_TRACE(shape_name(k));
     const auto truth = shape_truth(k, 7.5 * R, Vec3(3, -2, 40));
-    std::vector<Vec3> dense;
-    for (uint64_t i = 0; i < 200000; ++i) dense.push_back(truth->sample(3, i).point);
-    for (int q = 0; q < 40; ++q) {
-      const Vec3 p = Vec3(3, -2, 40) + 12 * Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
-      const SurfacePoint c = truth->closest(p);
-      double best = INFINITY;
-      for (const Vec3& d : dense) best = std::min(best, (d - p).norm());
-      const double exact = (c.point - p).norm();
-      EXPECT_LE(exact, best + 1e-9);
-      EXPECT_GE(exact, best - 0.08);  // samples are ~0.05 apart on this 7.5x shape
-      EXPECT_NEAR(c.normal.norm(), 1.0, 1e-12);
-      // The closest point is on the surface: inside just below, outside just above.
-      EXPECT_TRUE(truth->contains(c.point - 1e-6 * c.normal));
-      EXPECT_FALSE(truth->contains(c.point + 1e-6 * c.normal));
-    }
+    expect_exact_closest_points(*truth, rng);
   }
 }
 
@@ -113,19 +120,7 @@ TEST(Truth, FilletedBoxIsExactAndHasNoSharpEdges) {
   const Mat3 R = parse_rotation("random:12");
   const double f = 0.2;  // model units (the box's half extents: 1, 0.75, 0.5)
   const auto truth = shape_truth(ShapeKind::box, 7.5 * R, Vec3(3, -2, 40), f);
-  std::vector<Vec3> dense;
-  for (uint64_t i = 0; i < 200000; ++i) dense.push_back(truth->sample(3, i).point);
-  for (int q = 0; q < 40; ++q) {
-    const Vec3 p = Vec3(3, -2, 40) + 12 * Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
-    const SurfacePoint c = truth->closest(p);
-    double best = INFINITY;
-    for (const Vec3& d : dense) best = std::min(best, (d - p).norm());
-    const double exact = (c.point - p).norm();
-    EXPECT_LE(exact, best + 1e-9);
-    EXPECT_GE(exact, best - 0.08);
-    EXPECT_TRUE(truth->contains(c.point - 1e-6 * c.normal));
-    EXPECT_FALSE(truth->contains(c.point + 1e-6 * c.normal));
-  }
+  expect_exact_closest_points(*truth, rng);
   // Area: the sharp box's minus what rounding takes (Steiner), as the sampler's pieces add up.
   const double pi = std::numbers::pi, s2 = 7.5 * 7.5;
   const Vec3 h = Vec3(1, 0.75, 0.5) - Vec3::Constant(f);
