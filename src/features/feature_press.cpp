@@ -34,6 +34,20 @@ std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
   return frozen;
 }
 
+// The first estimate's press.
+PressOptions estimate_options(const PressOptions& po) {
+  PressOptions eo = po;
+  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
+  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
+  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
+  // that no plane merges back).
+  eo.levels = 2;
+  eo.tolerance = 0;
+  eo.progress = nullptr;
+  eo.free_ends = false;  // see PressOptions::free_ends
+  return eo;
+}
+
 // The flats of a surface from its estimates (Section 4, last paragraph):
 // press a copy, detect, and (beyond the paper) press again with the first
 // flats frozen and detect from scratch. `est` ends as the last estimate;
@@ -51,15 +65,7 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
-  PressOptions eo = po;
-  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
-  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
-  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
-  // that no plane merges back).
-  eo.levels = 2;
-  eo.tolerance = 0;
-  eo.progress = nullptr;
-  eo.free_ends = false;  // see PressOptions::free_ends
+  const PressOptions eo = estimate_options(po);
   g.first = detail::press_on(g.est, layout, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
@@ -121,9 +127,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const PressStats& first_estimate = g.first;
   const StickSurface& est = g.est;
   const bool est_is_plain = g.plain;
-  PressOptions eo = po;  // the first estimate's schedule
-  eo.iterations = detail::kEstimateIterations;
-  eo.levels = 2;
+  const PressOptions eo = estimate_options(po);
   apply_flats(s, seg);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
   // by the curved side's fit (fit_creases), and those of creases between

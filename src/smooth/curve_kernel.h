@@ -236,7 +236,7 @@ struct Family {
 // press_levels resolved it. Jacobi updates: deterministic for any thread count.
 /// The press's layout of a surface: vertices in brick Morton order relative
 /// to the sticks' box (new_of[stick] = vertex, old_of[vertex] = stick), the
-/// three plane families, and the press's levels for its extent.
+/// three plane families, and the box's extent (for the press's levels).
 struct Layout {
   std::vector<uint32_t> old_of, new_of;
   std::vector<uint32_t> ids[3];
