@@ -331,6 +331,8 @@ PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, co
     r = press_chunked(volume.lattice, "array", [&](const Box& box) { return crop(volume, box); }, o, chunks, &st);
   }
   out.mesh = std::move(r.mesh);
+  out.lattice = scalar.lattice;
+  if (o.simplify.faces || o.simplify.max_error) out.stats["simplify"] = simplify_stats(r.simplify);
   out.stats["method"] = std::string(method_name(o.method));
   out.stats["blocks"] = st.blocks;
   out.stats["sticks"] = st.sticks;

@@ -4,6 +4,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <optional>
 #include <string>
 
 #include "voxpress/voxpress.h"
@@ -16,7 +17,12 @@ namespace voxpress::python {
 struct PyMesh {
   Mesh mesh;
   py::dict stats;
+  /// The volume's lattice when the mesh was made from one (press): its
+  /// samples keep their side when the mesh is simplified.
+  std::optional<Lattice> lattice;
 };
+/// stats["simplify"] of a simplified mesh.
+py::dict simplify_stats(const SimplifyStats& st);
 
 /// A lattice of `dims` from press()'s spacing, origin and direction
 /// arguments (validated: UsageError naming the bad one).

@@ -184,11 +184,24 @@ void set_options(SurfaceOptions& o, const py::kwargs& kw) {
     else if (k == "fit_rings") o.fit.rings = option<int>(k, value);
     else if (k == "lambda_") o.overrides.lambda = option<double>(k, value);
     else if (k == "mu") o.overrides.mu = option<double>(k, value);
+    else if (k == "faces") o.simplify.faces = option<uint64_t>(k, value);
+    else if (k == "max_error") o.simplify.max_error = option<double>(k, value);
     else
       throw py::type_error("press() got an unknown option '" + k +
                            "' (iterations, tolerance, flats, sharpen, min_flat_area, junction_angle, sharp_angle, "
-                           "disable_passes, color_regions, fit_rings, lambda_, mu)");
+                           "disable_passes, color_regions, fit_rings, lambda_, mu, faces, max_error)");
   }
+}
+
+py::dict simplify_stats(const SimplifyStats& st) {
+  py::dict d;
+  d["faces_before"] = st.faces_before;
+  d["faces"] = st.faces_after;
+  d["vertices"] = st.vertices_after;
+  d["collapses"] = st.collapses;
+  d["error"] = st.error;
+  d["seconds"] = st.seconds;
+  return d;
 }
 
 }  // namespace voxpress::python
@@ -222,6 +235,7 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
   // ArrayLike: nested lists and anything numpy.asarray takes.
   const py::array mask = py::module_::import("numpy").attr("asarray")(mask_like);
   ScalarVolume scalar = to_volume(mask, spacing, origin, direction, axes);
+  const Lattice lattice = scalar.lattice;
   if (chunks) return press_chunked_volume(scalar, sel, o, *chunks);  // as press --chunk [--halo]
   SurfaceResult r;
   double seconds_binarize = 0;
@@ -235,6 +249,8 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
   }
   PyMesh out;
   out.mesh = std::move(r.mesh);
+  out.lattice = lattice;
+  if (o.simplify.faces || o.simplify.max_error) out.stats["simplify"] = simplify_stats(r.simplify);
   const bool pressing = o.method == Method::pressing;
   out.stats["method"] = method;
   out.stats["sticks"] = r.extract.sticks;
@@ -531,6 +547,28 @@ PYBIND11_MODULE(_voxpress, m) {
         return a;
       }, "K x 2 int32 vertex pairs of the sharp feature curves")
       .def_readonly("stats", &PyMesh::stats, "what the call did: method, counts, iterations, seconds")
+      .def("simplify", [](const PyMesh& pm, uint64_t faces, double max_error) {
+        PyMesh out;
+        out.mesh = pm.mesh;
+        out.lattice = pm.lattice;
+        SimplifyOptions o;
+        o.faces = faces;
+        o.max_error = max_error;
+        o.lattice = pm.lattice ? &*pm.lattice : nullptr;
+        if (!(max_error >= 0) || !std::isfinite(max_error)) throw UsageError("max_error must be finite and >= 0");
+        SimplifyStats st;
+        {
+          py::gil_scoped_release release;
+          st = simplify(out.mesh, o);
+        }
+        out.stats = py::dict(pm.stats);
+        out.stats["vertices"] = out.mesh.vertex_count();
+        out.stats["triangles"] = out.mesh.face_count();
+        out.stats["sharp_edges"] = out.mesh.edges.size();
+        out.stats["simplify"] = simplify_stats(st);
+        return out;
+      }, py::kw_only(), py::arg("faces") = 0, py::arg("max_error") = 0.0,
+         "A simplified copy (see voxpress/__init__.pyi)")
       .def("save", [](const PyMesh& pm, const std::string& path, bool ascii) {
         MeshWriteOptions o;
         o.ascii = ascii;

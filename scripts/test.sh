@@ -16,7 +16,7 @@ phase "Release suite done"
 [ "${VOXPRESS_NO_SANITIZE:-0}" = 1 ] && exit 0
 
 echo "== the unit and property tests under ASan + UBSan" >&2
-suites=(core_tests extract_tests io_tests eval_tests smooth_tests voxart_tests render_tests)
+suites=(core_tests extract_tests io_tests eval_tests smooth_tests simplify_tests voxart_tests render_tests)
 # clang when present (setup installs it): it compiles the sanitized library
 # in half gcc's time.
 compilers=(); command -v clang++ >/dev/null 2>&1 && compilers=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang)
@@ -66,11 +66,12 @@ Sharpen.CurvedCreasesOnlyWhereTheyContinueAFlatsCrease:Pressing.ArcLengthResampl
 Pipeline.PressingStagesAndOverridesAreHonoured:Flats.WithoutFlatsTheResultIsThePlainPress:\
 Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtRandomRotations:\
 VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts:Sharpen.FilletsTheLatticeResolvesStayRound:\
-Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedShapesGiveTheSameT"
+Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedShapesGiveTheSameT:\
+Simplify.SameBytesForAnyThreadCount"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.
 runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 io_tests:0:1 extract_tests:0:1
-      voxart_tests:0:1 core_tests:0:1 render_tests:0:1)
+      simplify_tests:0:1 voxart_tests:0:1 core_tests:0:1 render_tests:0:1)
 printf '%s\n' "${runs[@]}" | xargs -P "$(nproc)" -I{} sh -c '
   run=$1; t=${run%%:*}; rest=${run#*:}; i=${rest%%:*}; n=${rest#*:}
   log="$0/build-asan/$t.$i.log"

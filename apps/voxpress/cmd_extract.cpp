@@ -11,6 +11,7 @@ struct ExtractCmd {
   std::string input, output, stats_json;
   InputOptions in;
   bool ascii = false, check = false, labels = false;
+  SimplifyOptions simplify;  ///< --faces, --max-error
 };
 
 // --labels: the shared surface; --check checks every label's closed surface.
@@ -60,12 +61,23 @@ void run_extract(const ExtractCmd& c, const Global& g) {
   check_paths({c.input}, {{c.output, OutputKind::mesh}, {c.stats_json, OutputKind::json}});
 
   mesh_format_from_path(c.output);  // fail on a bad extension before any work
-  if (c.labels) return run_extract_labels(c, g);
+  const bool simplifying = c.simplify.faces || c.simplify.max_error;
+  if (c.labels) {
+    if (simplifying) throw UsageError("--faces and --max-error do not apply with --labels yet");
+    return run_extract_labels(c, g);
+  }
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   const VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());
-  const Mesh mesh = to_mesh(vs.surface);
+  Mesh mesh = to_mesh(vs.surface);
   const double t_extract = clock.seconds();
+  SimplifyStats simplified;
+  if (simplifying) {
+    SimplifyOptions so = c.simplify;
+    so.lattice = &vs.volume.lattice;
+    so.progress = bar.get();
+    simplified = simplify(mesh, so);
+  }
   const nlohmann::json checks = c.check ? check_surface(mesh, vs.volume, bar.get(), "extracted") : nlohmann::json();
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
@@ -80,6 +92,7 @@ void run_extract(const ExtractCmd& c, const Global& g) {
                     {"triangles", vs.stats.seconds_triangles},
                     {"extract_total", t_extract - vs.seconds_read},
                     {"total", clock.seconds()}};
+    if (simplifying) j["simplify"] = simplify_stats_json(simplified, c.simplify);
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
     write_json(c.stats_json, j);
@@ -99,6 +112,7 @@ void register_extract(CLI::App& app, Global& g) {
   cmd->add_flag("--labels", c->labels,
                 "Every label of a label map in one surface, each interface shared by its two labels "
                 "(face attributes label_in, label_out; PLY keeps them)");
+  bind_simplify(*cmd, c->simplify);
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");
   cmd->callback([c, &g] {
     g.apply();

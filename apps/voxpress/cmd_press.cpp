@@ -28,6 +28,7 @@ struct PressCmd {
   std::string labels, label_names, format = "ply";
   MethodOverrides overrides;  ///< --lambda, --mu; --iterations / --tolerance are PressCli's
   ChunkOptions chunks;
+  SimplifyOptions simplify;  ///< --faces, --max-error
   CLI::App* cmd = nullptr;
 };
 
@@ -184,7 +185,7 @@ Pressed press_chunked_file(const PressCmd& c, const SurfaceOptions& so, const Gl
 void run_press(const PressCmd& c, const Global& g) {
   const bool labels = !c.labels.empty();
   if (labels) {
-    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--halo"})
+    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--halo", "--faces", "--max-error"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --labels");
     check_paths({c.input}, {{c.stats_json, OutputKind::json}});
   } else {
@@ -219,6 +220,7 @@ void run_press(const PressCmd& c, const Global& g) {
   so.overrides.lambda = c.overrides.lambda;
   so.overrides.mu = c.overrides.mu;
   so.extract.max_bytes = g.memory_limit();
+  so.simplify = c.simplify;
   if (labels) {
     // The shared surface has no region colours and no quadric fit.
     if (pressing && !c.separate)
@@ -303,6 +305,7 @@ void run_press(const PressCmd& c, const Global& g) {
       j["seconds"] = {{"read", seconds_read}, {"extract", r.seconds_extract}, {"smooth", r.seconds_smooth},
                       {"total", clock.seconds()}};
     }
+    if (so.simplify.faces || so.simplify.max_error) j["simplify"] = simplify_stats_json(r.simplify, so.simplify);
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
     write_json(c.stats_json, j);
@@ -375,6 +378,7 @@ void register_press(CLI::App& app, Global& g) {
                  "Also press each block apart, reading this many samples around it (memory: one block's surface; "
                  "Pressing only, no flats; vertices near block borders move, docs/BENCHMARKS.md)")
       ->check(CLI::Range(int64_t(1), int64_t(256)));
+  bind_simplify(*cmd, c->simplify);
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_flag("--check", c->check, "Verify the mesh (check_mesh + classification) before writing");
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");

@@ -11,6 +11,7 @@ struct SmoothMeshCmd {
   std::string input, output, stats_json;
   std::string method = "constrained", constraint = "diamond";
   MethodOverrides overrides;
+  SimplifyOptions simplify;  ///< --faces, --max-error
   bool ascii = false;
   CLI::Option* constraint_option = nullptr;
 };
@@ -37,6 +38,7 @@ void run_smooth_mesh(const SmoothMeshCmd& c, const Global& g) {
   j["output"] = c.output;
   SmoothStats st;
   double seconds_recover = 0;
+  std::optional<Lattice> lattice;  // the recovered one: its samples keep their side when simplifying
   if (kind) {
     if (mesh.triangles.empty()) throw InputError(c.input, "the mesh has no triangles");
     FairOptions fo = fair_defaults(*kind);
@@ -53,10 +55,17 @@ void run_smooth_mesh(const SmoothMeshCmd& c, const Global& g) {
     co.progress = bar.get();
     st = constrained_smooth(lm, co);
     mesh = std::move(lm.mesh);
+    lattice = lm.lattice;
     j["method"] = "constrained";
     j["constraint"] = constraint_name(constraint);
     j["recovered_lattice"] = lattice_json(lm.lattice);
     j["recovered_lattice"]["misfit_cells"] = lm.misfit;
+  }
+  if (c.simplify.faces || c.simplify.max_error) {
+    SimplifyOptions so = c.simplify;
+    so.lattice = lattice ? &*lattice : nullptr;  // taubin / laplacian: no lattice, no samples to keep
+    so.progress = bar.get();
+    j["simplify"] = simplify_stats_json(simplify(mesh, so), c.simplify);
   }
   MeshWriteOptions wo;
   wo.ascii = c.ascii;
@@ -94,6 +103,7 @@ void register_smooth_mesh(CLI::App& app, Global& g) {
   cmd->add_option("--tolerance", c->overrides.tolerance,
                   "Stop when no vertex moved more than this in one iteration, in cells (default 0.002)");
   bind_fairing(*cmd, c->overrides);
+  bind_simplify(*cmd, c->simplify);
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");
   cmd->add_option("--stats-json", c->stats_json, "Write the recovered lattice, iterations and timings as JSON");
   cmd->callback([c, &g] {

@@ -215,6 +215,25 @@ nlohmann::json smooth_stats_json(const SmoothStats& st) {
           {"seconds", st.seconds}};
 }
 
+void bind_simplify(CLI::App& cmd, SimplifyOptions& o) {
+  auto* g = cmd.add_option_group("simplify", "Fewer triangles, every sample still on its side");
+  g->add_option("--faces", o.faces, "Simplify to at most this many triangles (fewer collapses only where one would "
+                                    "move a sample across, fold or cross the surface, or exceed --max-error)");
+  g->add_option("--max-error", o.max_error, "Simplify, keeping every input vertex within this distance of the result "
+                                            "(physical units, e.g. mm; with --faces, both hold)")
+      ->check(CLI::Range(0.0, 1e30));
+}
+
+nlohmann::json simplify_stats_json(const SimplifyStats& st, const SimplifyOptions& o) {
+  return {{"faces_target", o.faces},          {"max_error", o.max_error},
+          {"faces_before", st.faces_before},  {"faces", st.faces_after},
+          {"vertices", st.vertices_after},    {"collapses", st.collapses},
+          {"error", st.error},
+          {"refused", {{"topology", st.refused_topology}, {"shape", st.refused_shape}, {"samples", st.refused_samples},
+                       {"clash", st.refused_clash}, {"error", st.refused_error}}},
+          {"seconds", st.seconds}};
+}
+
 nlohmann::json press_stats_json(const PressStats& st, const PressOptions& o) {
   return {{"iterations", st.iterations},    {"max_iterations", o.iterations},
           {"residual", st.residual}, {"tolerance", o.tolerance}, {"curves", st.curves},

@@ -100,6 +100,10 @@ void bind_fairing(CLI::App& cmd, MethodOverrides& overrides);
 std::optional<FairOptions::Kind> fair_kind(const std::string& method);
 nlohmann::json smooth_stats_json(const SmoothStats& st);
 
+/// Adds --faces and --max-error (the simplifier) to a command.
+void bind_simplify(CLI::App& cmd, SimplifyOptions& o);
+nlohmann::json simplify_stats_json(const SimplifyStats& st, const SimplifyOptions& o);
+
 /// `--check` of extract and press: check_mesh and the classification against
 /// the volume, before anything is written. When strict (methods that promise
 /// both), throws Error ("the <what> surface failed its checks: ...") on a

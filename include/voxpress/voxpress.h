@@ -31,6 +31,7 @@
 #include "voxpress/chunk/chunked_labels.h"
 #include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
+#include "voxpress/simplify/simplify.h"
 #include "voxpress/voxart/polygonize.h"
 #include "voxpress/voxart/voxel_art.h"
 

@@ -29,7 +29,7 @@ from ._voxpress import (  # noqa: F401
 def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None, method="pressing",
           axes="xyz", label=None, threshold=None, iterations=None, tolerance=None, flats=None, sharpen=None,
           min_flat_area=None, junction_angle=None, sharp_angle=None, disable_passes=None, color_regions=None,
-          fit_rings=None, lambda_=None, mu=None, chunk=None, halo=None):
+          fit_rings=None, lambda_=None, mu=None, chunk=None, halo=None, faces=None, max_error=None):
     """The smooth surface of a 3-D mask, as `voxpress press` computes it; returns a Mesh.
 
     mask: bool, integer-label or float array (anything numpy.asarray takes);
@@ -53,6 +53,10 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
       chunk, halo  block by block, as `press --chunk N [--halo H]`: without a
                    halo the same mesh; with one, blocks pressed apart (no
                    flats); voxpress.dask runs the blocks on Dask
+      faces, max_error  simplify the result (as `press --faces / --max-error`):
+                   at most `faces` triangles, every input vertex within
+                   max_error (physical units), every sample still on its side;
+                   Mesh.simplify does the same to a mesh afterwards
     Out-of-range values raise UsageError with the command line's message; the
     GIL is released while it works.
     """
@@ -60,7 +64,7 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
                    min_flat_area=min_flat_area, junction_angle=junction_angle, sharp_angle=sharp_angle,
                    disable_passes=None if disable_passes is None else list(disable_passes),
                    color_regions=color_regions, fit_rings=fit_rings,
-                   lambda_=lambda_, mu=mu, chunk=chunk, halo=halo)
+                   lambda_=lambda_, mu=mu, chunk=chunk, halo=halo, faces=faces, max_error=max_error)
     return _voxpress.press(mask, spacing=spacing, origin=origin, direction=direction, method=method, axes=axes,
                            label=label, threshold=threshold,
                            **{k: v for k, v in options.items() if v is not None})

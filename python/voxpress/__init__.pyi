@@ -51,6 +51,11 @@ class Mesh:
     @property
     def stats(self) -> dict[str, Any]:
         """method, sticks, vertices, triangles, iterations, flats, sharp_edges, keeps_classification, seconds_*."""
+    def simplify(self, *, faces: int = 0, max_error: float = 0.0) -> "Mesh":
+        """A copy with at most `faces` triangles and/or every vertex of this mesh within `max_error` (physical
+        units) of it; labelled sharp edges, flat borders and regions are kept. A mesh from press() keeps every
+        sample of its volume on its side (and stays closed, manifold, without self-intersection); a mesh read
+        from a file keeps all but the samples, which it does not know. stats["simplify"]: faces, error, seconds."""
     def save(self, path: str, ascii: bool = False) -> None:
         """Writes .ply .obj .stl .off .glb .gltf .vtk .vtp atomically (no partial file on failure)."""
 
@@ -77,8 +82,13 @@ def press(
     mu: float = ...,
     chunk: Optional[int] = None,
     halo: int = 0,
+    faces: int = 0,
+    max_error: float = 0.0,
 ) -> Mesh:
     """The smooth surface of a 3-D mask, as `voxpress press` computes it.
+
+    faces / max_error: simplify the result (as `press --faces / --max-error`),
+    every sample still on its side.
 
     mask: bool, integer-label or float array; C or Fortran order. axes="xyz"
     indexes it mask[i, j, k] (nibabel); "zyx" mask[k, j, i]

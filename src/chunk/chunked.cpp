@@ -426,6 +426,7 @@ SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, c
     r.mesh = to_mesh(surface);
     r.press.iterations = st.max_iterations;
     r.press.levels = st.levels;
+    simplify_result(lattice, options, r);
   }
   if (stats) *stats = st;
   return r;

@@ -98,6 +98,8 @@ void validate(const SurfaceOptions& o) {
   if (ov.mu) in_range(*ov.mu, -10, 10, "mu");
   const PressOptions& p = o.press;
   in_range(p.iterations, 0, kMaxIterations, "iterations");
+  in_range(o.simplify.max_error, 0, 1e300, "max_error");
+  if (!o.simplify.soft_keys.empty()) throw UsageError("simplify.soft_keys is voxel art's; a volume's surface keeps its borders");
   in_range(p.tolerance, 0, 1, "tolerance");
   in_range(p.step, 1e-6, 2, "step");
   in_range(p.arc_length, 1e-3, 16, "arc_length");
@@ -215,7 +217,16 @@ SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, Surfa
     }
   }
   r.seconds_smooth = seconds_since(t0);
+  simplify_result(surface.lattice, o, r);
   return r;
+}
+
+void simplify_result(const Lattice& lattice, const SurfaceOptions& o, SurfaceResult& r) {
+  if (o.simplify.faces == 0 && o.simplify.max_error == 0) return;
+  SimplifyOptions so = o.simplify;
+  so.lattice = &lattice;
+  if (o.progress) so.progress = o.progress;
+  r.simplify = simplify(r.mesh, so);
 }
 
 }  // namespace voxpress

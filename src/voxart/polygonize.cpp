@@ -12,6 +12,7 @@
 #include "../eval/mesh_query.h"
 #include "atlas.h"
 #include "voxpress/smooth/mesh_smoothing.h"
+#include "voxpress/simplify/simplify.h"
 #include "voxpress/smooth/pipeline.h"
 
 namespace voxpress {
@@ -220,7 +221,10 @@ VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& opti
       }
     else
       for (size_t f = 0; f < keys.size(); ++f) keys[f] = pack(quad_color[tri_quad[f]]);
-    simplify_mesh(work, options.target_faces, keys);
+    SimplifyOptions so;
+    so.faces = options.target_faces;
+    so.soft_keys = std::move(keys);
+    voxpress::simplify(work, so);
   }
   st.seconds_simplify = seconds_since(t0);
   auto face_color = [&](uint32_t f, const Vec3& p) { return direct ? quad_color[tri_quad[f]] : reference_color(p); };

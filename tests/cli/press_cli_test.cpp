@@ -347,5 +347,40 @@ TEST(Cli, PressRunsEveryMethodAndChecksOnlyWhatEachPromises) {
   EXPECT_FALSE(std::filesystem::exists(tmp.path("x.ply")));
 }
 
+// --faces and --max-error: press, extract and smooth-mesh simplify what they
+// write, every sample still on its side (checked on the file as written by
+// `check`), the figures in --stats-json; a bad bound is a usage error.
+TEST(Cli, FacesSimplifiesAndKeepsEverySampleOnItsSide) {
+  test::TempDir tmp;
+  std::string out;
+  const std::string vol = tmp.path("c.nrrd");
+  ASSERT_EQ(run_cli("-q generate cad-part --res 32 --rotate random:2 -o " + vol, &out), 0) << out;
+  ASSERT_EQ(run_cli("-q press " + vol + " -o " + tmp.path("p.stl") + " --faces 600 --check --stats-json " +
+                        tmp.path("p.json"),
+                    &out),
+            0)
+      << out;
+  const auto st = nlohmann::json::parse(std::ifstream(tmp.path("p.json")));
+  EXPECT_LE(st["simplify"]["faces"].get<uint64_t>(), 600u);
+  EXPECT_GT(st["simplify"]["faces_before"].get<uint64_t>(), 3000u);
+  EXPECT_EQ(st["counts"]["triangles"], st["simplify"]["faces"]);
+  EXPECT_EQ(st["checks"]["classification_violations"], 0);
+  ASSERT_EQ(run_cli("check " + tmp.path("p.stl") + " --volume " + vol, &out), 0) << out;
+  // extract: the midpoint surface within half a cell of itself.
+  ASSERT_EQ(run_cli("-q extract " + vol + " -o " + tmp.path("m.ply") + " --max-error 0.5 --stats-json " + tmp.path("m.json"), &out), 0)
+      << out;
+  const auto sm = nlohmann::json::parse(std::ifstream(tmp.path("m.json")));
+  EXPECT_LE(sm["simplify"]["error"].get<double>(), 0.5);
+  EXPECT_LT(sm["simplify"]["faces"].get<uint64_t>(), sm["simplify"]["faces_before"].get<uint64_t>() / 2);
+  ASSERT_EQ(run_cli("check " + tmp.path("m.ply") + " --volume " + vol, &out), 0) << out;
+  // smooth-mesh: the lattice read back from the midpoint mesh keeps its samples.
+  ASSERT_EQ(run_cli("-q extract " + vol + " -o " + tmp.path("mc.stl"), &out), 0) << out;
+  ASSERT_EQ(run_cli("-q smooth-mesh " + tmp.path("mc.stl") + " -o " + tmp.path("sm.ply") + " --faces 800", &out), 0) << out;
+  ASSERT_EQ(run_cli("check " + tmp.path("sm.ply") + " --volume " + vol, &out), 0) << out;
+  EXPECT_NE(run_cli("-q press " + vol + " -o " + tmp.path("x.ply") + " --max-error -1", &out), 0);
+  EXPECT_NE(out.find("--max-error"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(tmp.path("x.ply")));
+}
+
 }  // namespace
 }  // namespace voxpress

@@ -191,6 +191,27 @@ def test_mesh_outputs_and_evaluation(tmp_path):
     assert abs(q["result_to_truth_rule_rms_vox"] - sampled) < 0.03 * sampled
 
 
+def test_simplify_keeps_every_sample_on_its_side(tmp_path):
+    vol = tmp_path / "part.nrrd"
+    cli("generate", "cad-part", "--res", 32, "--rotate", "random:4", "-o", vol)
+    data, lat = voxpress.read_volume(str(vol))
+    where = dict(spacing=lat.spacing, origin=lat.origin, direction=lat.direction)
+    full = voxpress.press(data, **where)
+    small = voxpress.press(data, faces=700, **where)
+    assert len(small.faces) <= 700 < len(full.faces) / 4
+    assert small.stats["simplify"]["faces_before"] == len(full.faces)
+    assert len(small.sharp_edges) > 0
+    again = full.simplify(faces=700)  # the same collapses on the same mesh
+    np.testing.assert_array_equal(again.vertices, small.vertices)
+    np.testing.assert_array_equal(again.faces, small.faces)
+    bounded = full.simplify(max_error=0.2)
+    assert bounded.stats["simplify"]["error"] <= 0.2 and len(bounded.faces) < len(full.faces)
+    for m in (small, bounded):
+        assert voxpress.check(m, str(vol))["classification_violations"] == 0
+    with pytest.raises(voxpress.UsageError, match="max_error"):
+        full.simplify(max_error=-1)
+
+
 def rss_bytes():
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")

@@ -327,7 +327,10 @@ TEST(Simplify, ReachesTheTargetAndStaysClosedManifoldAndOriented) {
     std::vector<uint32_t> keys(m.triangles.size());
     for (size_t f = 0; f < keys.size(); ++f) keys[f] = q.colors[f / 2][0];
     const uint64_t target = m.triangles.size() / (4 + uint64_t(trial % 4));
-    simplify_mesh(m, target, keys);
+    SimplifyOptions so;
+    so.faces = target;
+    so.soft_keys = keys;
+    simplify(m, so);
     const MeshCheck after = check_mesh(m, {.self_intersections = false});
     EXPECT_TRUE(after.closed() && after.manifold() && after.oriented()) << (after.problems.empty() ? "" : after.problems[0]);
     EXPECT_EQ(after.euler, before.euler);

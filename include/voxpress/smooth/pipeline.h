@@ -27,6 +27,7 @@
 #include "voxpress/smooth/pressing.h"
 #include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/surface_nets.h"
+#include "voxpress/simplify/simplify.h"
 
 namespace voxpress {
 
@@ -66,6 +67,10 @@ struct SurfaceOptions {
   // taubin and laplacian only (UsageError otherwise)
   MethodOverrides overrides;
   // --- all
+  /// Fewer triangles at the end, every sample still on its side
+  /// (voxpress/simplify/simplify.h): faces and max_error; the lattice is the
+  /// volume's. Both zero (the default): no simplification.
+  SimplifyOptions simplify;
   ExtractOptions extract;
   Progress* progress = nullptr;  ///< overrides the stages' own progress pointers
 };
@@ -82,6 +87,7 @@ struct SurfaceResult {
   SmoothStats smooth;          ///< diamond, cell-edge, cell-size, taubin, laplacian
   SurfaceNetStats net;         ///< cesn
   PassTimes pass_times;         ///< pressing: seconds and counts per pass
+  SimplifyStats simplify;      ///< with options.simplify set
   double seconds_extract = 0, seconds_smooth = 0;
 };
 
@@ -115,5 +121,10 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
 /// press_chunked's exact mode runs it on the sticks stitched from blocks.
 /// r carries what the caller measured before (extract stats and seconds).
 SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& options, SurfaceResult r = {});
+
+/// The last stage: r.mesh simplified by options.simplify against `lattice`'s
+/// samples (nothing when neither faces nor max_error is set); fills
+/// r.simplify. smooth_sticks runs it; press_chunked's halo mode too.
+void simplify_result(const Lattice& lattice, const SurfaceOptions& options, SurfaceResult& r);
 
 }  // namespace voxpress

@@ -18,9 +18,9 @@
 //   3. attribute smoothing (Section 4.4): vertex normals = mean of the
 //      distinct adjacent face normals, vertex colours = mean of the adjacent
 //      quads' colours.
-//   4. optional simplification (quadric error metric with colour-border
-//      constraint planes, link condition: stays closed and 2-manifold), done
-//      before the atlas so the texture is rendered for the final triangles.
+//   4. optional simplification (voxpress/simplify/simplify.h, colour
+//      borders penalised, not kept), done before the atlas so the texture is
+//      rendered for the final triangles.
 //   5. texture atlas (Section 4.5): charts grown from the most axis-aligned
 //      faces while the normal stays within 60 degrees of the seed's, projected
 //      on the seed's plane, packed, and rendered from the voxel colours with
@@ -108,14 +108,5 @@ struct VoxartResult {
 
 /// The whole pipeline over every part of `art`.
 VoxartResult polygonize_voxel_art(const VoxelArt& art, const VoxartOptions& options = {});
-
-/// Quadric-error simplification to at most `target` triangles (fewer only
-/// when no further collapse keeps the mesh valid). Collapses keep the mesh
-/// closed and 2-manifold (link condition), never flip a face and never
-/// collapse a tetrahedron; edges between faces of different `face_keys` (e.g.
-/// colours) carry constraint planes so such borders are kept.
-/// Returns, per output face, nothing; the mesh is rewritten in place
-/// (vertex attributes other than positions are dropped).
-void simplify_mesh(Mesh& mesh, uint64_t target, const std::vector<uint32_t>& face_keys = {});
 
 }  // namespace voxpress

@@ -1,0 +1,409 @@
+// The simplifier: state, the order of the collapses, and the output
+// (Garland and Heckbert 1997 for the quadrics and the order; the checks are
+// in collapse_checks.cpp).
+#include "simplify/collapser.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <queue>
+#include <stdexcept>
+
+#include "core/clearance.h"
+#include "core/timing.h"
+#include "eval/mesh_query.h"
+
+namespace voxpress::detail {
+
+namespace {
+
+// Edge lengths: the quadric's minimiser is used only within this many of
+// the edge's midpoint (farther means the quadric is nearly singular along
+// the move; the endpoints are then the candidates).
+constexpr double kOptimumReach = 2;
+
+}  // namespace
+
+Quadric Quadric::plane(const Vec3& n, double c, double w) {
+  const double d = -c;
+  Quadric q;
+  const double v[4] = {n.x(), n.y(), n.z(), d};
+  int k = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i; j < 4; ++j) q.a[k++] = w * v[i] * v[j];
+  return q;
+}
+
+Quadric& Quadric::operator+=(const Quadric& o) {
+  for (int k = 0; k < 10; ++k) a[k] += o.a[k];
+  return *this;
+}
+
+double Quadric::operator()(const Vec3& p) const {
+  const double x = p.x(), y = p.y(), z = p.z();
+  const double e = a[0] * x * x + 2 * a[1] * x * y + 2 * a[2] * x * z + 2 * a[3] * x + a[4] * y * y +
+                   2 * a[5] * y * z + 2 * a[6] * y + a[7] * z * z + 2 * a[8] * z + a[9];
+  return std::max(0.0, e);
+}
+
+bool Quadric::minimise(Vec3& x) const {
+  Mat3 A;
+  A << a[0], a[1], a[2], a[1], a[4], a[5], a[2], a[5], a[7];
+  const Vec3 b(-a[3], -a[6], -a[8]);
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(A);
+  const Vec3 ev = es.eigenvalues();
+  // Well conditioned: the smallest eigenvalue is not lost in the largest's
+  // rounding (a flat region or a straight crease is singular: endpoints).
+  if (!(ev.maxCoeff() > 0) || ev.minCoeff() <= 1e-6 * ev.maxCoeff()) return false;
+  x = es.eigenvectors() * ((es.eigenvectors().transpose() * b).cwiseQuotient(ev));
+  return x.allFinite();
+}
+
+bool Collapser::Entry::operator<(const Entry& e) const {
+  if (cost != e.cost) return cost > e.cost;
+  if (len2 != e.len2) return len2 > e.len2;
+  return std::tie(a, b) > std::tie(e.a, e.b);
+}
+
+Collapser::Collapser(Mesh& m, const SimplifyOptions& opt)
+    : mesh(m), o(opt), tri(m.triangles) {}
+
+void Collapser::build() {
+  const size_t nv = mesh.positions.size(), nf = tri.size();
+  xp = mesh.positions;
+  input = mesh.positions;
+  xi.resize(nv);
+  double reach = 0;
+  for (size_t v = 0; v < nv; ++v) {
+    xi[v] = o.lattice ? o.lattice->to_index(xp[v]) : xp[v];
+    reach = std::max(reach, xp[v].cwiseAbs().maxCoeff());
+  }
+  if (o.lattice) {
+    delta = float32_clearance(*o.lattice);
+    sample_lo = Vec3::Constant(-1);
+    sample_hi = Vec3(double(o.lattice->dims[0]), double(o.lattice->dims[1]), double(o.lattice->dims[2]));
+  } else {
+    delta = 4 * std::ldexp(std::max(reach, 1.0), -24);  // float32 rounding of the largest coordinate, 4x as in clearance.h
+  }
+  vf.assign(nv, {});
+  for (uint32_t f = 0; f < nf; ++f)
+    for (uint32_t v : tri[f]) vf[v].push_back(f);
+  face_alive.assign(nf, 1);
+  vertex_alive.assign(nv, 1);
+  moved.assign(nv, 0);
+  stamp.assign(nv, 0);
+  attached.assign(nf, {});
+  alive_faces = nf;
+
+  // Edges from sorted half-edges: each must have exactly two faces, in
+  // opposite directions (a closed, oriented 2-manifold).
+  struct Half {
+    uint64_t key;
+    uint32_t face;
+    bool forward;
+  };
+  std::vector<Half> he;
+  he.reserve(3 * nf);
+  for (uint32_t f = 0; f < nf; ++f)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t a = tri[f][size_t(c)], b = tri[f][size_t((c + 1) % 3)];
+      he.push_back({key(a, b), f, a < b});
+    }
+  std::sort(he.begin(), he.end(), [](const Half& x, const Half& y) { return std::tie(x.key, x.face) < std::tie(y.key, y.face); });
+  std::vector<uint64_t> edges;
+  for (size_t i = 0; i < he.size(); i += 2) {
+    if (i + 1 >= he.size() || he[i + 1].key != he[i].key || he[i].forward == he[i + 1].forward ||
+        (i + 2 < he.size() && he[i + 2].key == he[i].key))
+      throw std::invalid_argument("simplify: the mesh is not a closed, oriented 2-manifold");
+    edges.push_back(he[i].key);
+    const uint32_t f = he[i].face, g = he[i + 1].face;
+    bool hard = false;
+    for (const MeshAttribute& at : mesh.face_attributes) hard |= at.values[f] != at.values[g];
+    if (hard) feature[he[i].key] |= kBorder;
+  }
+  he = {};
+  for (const auto& e : mesh.edges) {
+    const auto it = std::lower_bound(edges.begin(), edges.end(), key(e[0], e[1]));
+    if (it != edges.end() && *it == key(e[0], e[1])) feature[*it] |= kSharp;
+  }
+
+  // Quadrics: each face's plane, weighted by its area; soft borders add
+  // their perpendicular planes, weighted by the squared border length.
+  Q.assign(nv, Quadric{});
+  for (uint32_t f = 0; f < nf; ++f) {
+    const Triangle& t = tri[f];
+    const Vec3 n = (xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]);
+    const double a2 = n.norm();
+    if (!(a2 > 0)) continue;
+    const Quadric q = Quadric::plane(n / a2, n.dot(xp[t[0]]) / a2, a2 / 2);
+    for (uint32_t v : t) Q[v] += q;
+  }
+  if (!o.soft_keys.empty())
+    for (uint64_t k : edges) {
+      const uint32_t a = uint32_t(k >> 32), b = uint32_t(k);
+      uint32_t fs[2], n = 0;
+      for (uint32_t f : vf[a])
+        if ((tri[f][0] == b || tri[f][1] == b || tri[f][2] == b) && n < 2) fs[n++] = f;
+      if (n != 2 || o.soft_keys[fs[0]] == o.soft_keys[fs[1]]) continue;
+      const Vec3 e = xp[b] - xp[a];
+      for (uint32_t h : fs) {
+        const Triangle& t = tri[h];
+        Vec3 m = e.cross((xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]));
+        if (!(m.norm() > 0)) continue;
+        m.normalize();
+        const Quadric q = Quadric::plane(m, m.dot(xp[a]), e.squaredNorm());
+        Q[a] += q;
+        Q[b] += q;
+      }
+    }
+  fdeg.assign(nv, 0);
+  for (const auto& [k, flags] : feature) {
+    const uint32_t a = uint32_t(k >> 32), b = uint32_t(k);
+    fdeg[a] = uint8_t(std::min(255, fdeg[a] + 1));
+    fdeg[b] = uint8_t(std::min(255, fdeg[b] + 1));
+  }
+  rebuild_grid();
+}
+
+void Collapser::rebuild_grid() {
+  double extent = 0;
+  for (uint32_t f = 0; f < tri.size(); ++f) {
+    if (!face_alive[f]) continue;
+    Vec3 lo, hi;
+    box_of(f, lo, hi);
+    extent += (hi - lo).maxCoeff();
+  }
+  grid.reset(std::max(extent / double(std::max<uint64_t>(alive_faces, 1)), 1e-3), tri.size());
+  for (uint32_t f = 0; f < tri.size(); ++f) {
+    if (!face_alive[f]) continue;
+    Vec3 lo, hi;
+    box_of(f, lo, hi);
+    grid.insert(f, lo, hi);
+  }
+  grid_faces = alive_faces;
+}
+
+// A vertex with no feature edge moves freely; one on exactly two (inside a
+// chain) slides along them; any other (a chain's end, a junction) stays.
+bool Collapser::removable(uint32_t u, uint32_t v) const {
+  if (fdeg[u] == 0) return true;
+  if (fdeg[u] != 2) return false;
+  const auto it = feature.find(key(u, v));
+  return it != feature.end();
+}
+
+int Collapser::moves(uint32_t a, uint32_t b, Move (&out)[3]) const {
+  Quadric q = Q[a];
+  q += Q[b];
+  const double len2 = (xp[a] - xp[b]).squaredNorm();
+  int n = 0;
+  if (removable(a, b)) out[n++] = {q(xp[b]), len2, a, b, xp[b]};
+  if (removable(b, a)) out[n++] = {q(xp[a]), len2, b, a, xp[a]};
+  if (fdeg[a] == 0 && fdeg[b] == 0) {
+    const Vec3 mid = (xp[a] + xp[b]) / 2;
+    Vec3 x;
+    if (q.minimise(x) && (x - mid).squaredNorm() <= kOptimumReach * kOptimumReach * len2 && x != xp[a] && x != xp[b])
+      out[n++] = {q(x), len2, std::max(a, b), std::min(a, b), x};
+  }
+  // Cheapest first; equal costs keep the order above (deterministic).
+  std::stable_sort(out, out + n, [](const Move& x, const Move& y) { return x.cost < y.cost; });
+  return n;
+}
+
+void Collapser::recount(uint32_t v) {
+  int n = 0;
+  for (uint32_t f : vf[v])
+    for (uint32_t w : tri[f])
+      if (w != v && feature.count(key(v, w))) ++n;
+  fdeg[v] = uint8_t(std::min(255, n / 2));  // each edge is seen from its two faces
+}
+
+void Collapser::box_of(uint32_t f, Vec3& lo, Vec3& hi) const {
+  const Triangle& t = tri[f];
+  lo = xi[t[0]].cwiseMin(xi[t[1]]).cwiseMin(xi[t[2]]);
+  hi = xi[t[0]].cwiseMax(xi[t[1]]).cwiseMax(xi[t[2]]);
+}
+
+void Collapser::apply(const Move& m) {
+  const uint32_t u = m.u, v = m.v;
+  for (uint32_t f : shared) {
+    face_alive[f] = 0;
+    grid.erase(f);
+    attached[f].clear();
+    for (uint32_t w : tri[f])
+      if (w != u && w != v) vf[w].erase(std::find(vf[w].begin(), vf[w].end(), f));
+  }
+  std::vector<uint32_t> keep;
+  for (uint32_t f : vf[v])
+    if (face_alive[f]) keep.push_back(f);
+  std::vector<uint32_t> from_u;
+  for (uint32_t f : vf[u]) {
+    if (!face_alive[f]) continue;
+    for (uint32_t& w : tri[f])
+      if (w == u) w = v;
+    keep.push_back(f);
+    from_u.push_back(f);
+  }
+  std::sort(keep.begin(), keep.end());
+  vf[v] = std::move(keep);
+  vf[u].clear();
+  vertex_alive[u] = 0;
+  alive_faces -= shared.size();
+  // Feature edges of u become v's (flags joined); u-v itself disappears.
+  std::vector<std::pair<uint32_t, uint8_t>> carried;
+  for (uint32_t w : nu) {
+    const auto it = feature.find(key(u, w));
+    if (it == feature.end()) continue;
+    if (w != v) carried.emplace_back(w, it->second);
+    feature.erase(it);
+  }
+  for (const auto& [w, flags] : carried) feature[key(v, w)] |= flags;
+  const bool v_moved = m.q != xp[v];
+  if (v_moved) {
+    moved[v] = 1;
+    xp[v] = m.q;
+    xi[v] = o.lattice ? o.lattice->to_index(m.q) : m.q;
+  }
+  moved[u] = 1;
+  Q[v] += Q[u];
+  ++stamp[u];
+  ++stamp[v];
+  for (uint32_t f : vf[v]) attached[f].clear();  // re-assigned below, from the checked assignment
+  for (const auto& [p, f] : assign) attached[f].push_back(p);
+  // The faces whose corners moved: u's, and v's too when v moved.
+  for (uint32_t f : v_moved ? vf[v] : from_u) {
+    Vec3 lo, hi;
+    box_of(f, lo, hi);
+    grid.move(f, lo, hi);
+  }
+  recount(v);
+  for (uint32_t w : nu) recount(w);
+  for (uint32_t w : nv_) recount(w);
+  ++st.collapses;
+}
+
+SimplifyStats Collapser::run() {
+  const auto t0 = std::chrono::steady_clock::now();
+  st.faces_before = tri.size();
+  const bool bounded = o.max_error > 0;
+  if (o.faces == 0 && !bounded) {  // nothing asked
+    st.faces_after = tri.size();
+    st.vertices_after = mesh.positions.size();
+    return st;
+  }
+  build();
+  std::priority_queue<Entry> heap;
+  const auto push = [&](uint32_t a, uint32_t b) {
+    Move mv[3];
+    const int n = moves(a, b, mv);
+    if (n == 0) return;
+    heap.push({mv[0].cost, mv[0].len2, std::min(a, b), std::max(a, b), stamp[std::min(a, b)], stamp[std::max(a, b)]});
+  };
+  for (uint32_t f = 0; f < tri.size(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t a = tri[f][size_t(c)], b = tri[f][size_t((c + 1) % 3)];
+      if (a < b) push(a, b);
+    }
+  const uint64_t target = o.faces;
+  ProgressCounter progress(o.progress, "simplify", target < st.faces_before ? (st.faces_before - target) / 2 : 0);
+  uint64_t since = 0;
+  while (alive_faces > target && !heap.empty()) {
+    const Entry e = heap.top();
+    heap.pop();
+    if (!vertex_alive[e.a] || !vertex_alive[e.b] || stamp[e.a] != e.sa || stamp[e.b] != e.sb) continue;
+    Move mv[3];
+    const int n = moves(e.a, e.b, mv);
+    for (int i = 0; i < n; ++i)
+      if (try_move(mv[i])) {
+        apply(mv[i]);
+        const uint32_t v = mv[i].v;
+        nu.clear();
+        for (uint32_t f : vf[v])
+          for (uint32_t w : tri[f])
+            if (w != v) nu.push_back(w);
+        std::sort(nu.begin(), nu.end());
+        nu.erase(std::unique(nu.begin(), nu.end()), nu.end());
+        for (uint32_t w : nu) push(v, w);
+        if (2 * alive_faces < grid_faces) rebuild_grid();
+        if (++since == 4096) {
+          progress.add(since);
+          since = 0;
+        }
+        break;
+      }
+  }
+  compact();
+  // The error: the farthest input vertex from the result (order-free max).
+  if (st.collapses > 0) {
+    const MeshQuery query(mesh);
+    st.error = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, input.size(), 4096), 0.0,
+        [&](const tbb::blocked_range<size_t>& r, double e) {
+          for (size_t v = r.begin(); v < r.end(); ++v)
+            if (moved[v]) e = std::max(e, query.closest(input[v]).dist2);
+          return e;
+        },
+        [](double x, double y) { return std::max(x, y); });
+    st.error = std::sqrt(st.error);
+  }
+  st.faces_after = tri.size();
+  st.vertices_after = mesh.positions.size();
+  st.seconds = seconds_since(t0);
+  return st;
+}
+
+void Collapser::compact() {
+  const size_t nv = xp.size(), nf = tri.size();
+  std::vector<uint32_t> remap(nv, UINT32_MAX);
+  uint32_t next = 0;
+  for (uint32_t v = 0; v < nv; ++v)
+    if (vertex_alive[v]) remap[v] = next++;
+  auto keep_vertices = [&](auto& values) {
+    if (values.empty()) return;
+    size_t k = 0;
+    for (size_t v = 0; v < nv; ++v)
+      if (vertex_alive[v]) values[k++] = values[v];
+    values.resize(k);
+  };
+  mesh.positions = xp;
+  keep_vertices(mesh.positions);
+  keep_vertices(mesh.colors);
+  keep_vertices(mesh.uvs);
+  for (MeshAttribute& a : mesh.vertex_attributes) keep_vertices(a.values);
+  size_t k = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    if (!face_alive[f]) continue;
+    Triangle t = tri[f];
+    for (uint32_t& w : t) w = remap[w];
+    tri[k] = t;
+    for (MeshAttribute& a : mesh.face_attributes) a.values[k] = a.values[f];
+    ++k;
+  }
+  tri.resize(k);
+  for (MeshAttribute& a : mesh.face_attributes) a.values.resize(k);
+  mesh.edges.clear();
+  for (const auto& [e, flags] : feature)
+    if (flags & kSharp) mesh.edges.push_back({remap[uint32_t(e >> 32)], remap[uint32_t(e)]});
+  std::sort(mesh.edges.begin(), mesh.edges.end());
+  if (!mesh.normals.empty()) mesh.normals = vertex_normals(mesh);
+}
+
+}  // namespace voxpress::detail
+
+namespace voxpress {
+
+SimplifyStats simplify(Mesh& mesh, const SimplifyOptions& options) {
+  if (!options.soft_keys.empty() && options.soft_keys.size() != mesh.triangles.size())
+    throw std::invalid_argument("simplify: soft_keys must have one key per face");
+  if (!(options.max_error >= 0) || !std::isfinite(options.max_error))
+    throw std::invalid_argument("simplify: max_error must be finite and non-negative");
+  mesh.validate();
+  detail::Collapser c(mesh, options);
+  return c.run();
+}
+
+}  // namespace voxpress

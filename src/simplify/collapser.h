@@ -1,0 +1,97 @@
+// The simplifier's state and its checked edge collapse (private; the
+// contract is voxpress/simplify/simplify.h).
+//
+// Positions live twice: physical (the quadrics, the error, the output) and
+// lattice index space (the samples, the clearance). A collapse removes
+// vertex u and keeps v at q; it is tried as two straight moves, u to q and
+// then v to q, and a sample can change side only if one of the moving
+// triangles sweeps over it (the tetrahedron of a triangle whose one corner
+// moves), so no sample in any swept tetrahedron, and none within the
+// clearance of the final triangles, means every sample keeps its side.
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "simplify/face_grid.h"
+#include "voxpress/simplify/simplify.h"
+
+namespace voxpress::detail {
+
+/// Symmetric 4x4 error quadric (Garland and Heckbert 1997): 10 coefficients
+/// xx xy xz xw yy yz yw zz zw ww.
+struct Quadric {
+  double a[10] = {};
+  /// weight * (n.x - c)^2 with n unit.
+  static Quadric plane(const Vec3& n, double c, double weight);
+  Quadric& operator+=(const Quadric& o);
+  double operator()(const Vec3& x) const;
+  /// The minimiser when the 3x3 part is well conditioned.
+  bool minimise(Vec3& x) const;
+};
+
+class Collapser {
+ public:
+  Collapser(Mesh& mesh, const SimplifyOptions& options);
+  SimplifyStats run();
+
+ private:
+  /// Remove u, keep v at q (physical).
+  struct Move {
+    double cost, len2;
+    uint32_t u, v;
+    Vec3 q;
+  };
+  struct Entry {
+    double cost, len2;
+    uint32_t a, b, sa, sb;
+    bool operator<(const Entry& o) const;  // a max-heap of this order pops the cheapest
+  };
+  enum : uint8_t { kSharp = 1, kBorder = 2 };  // feature edge flags
+  static uint64_t key(uint32_t a, uint32_t b) { return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a; }
+
+  // collapser.cpp
+  void build();
+  void push(uint32_t a, uint32_t b);
+  int moves(uint32_t a, uint32_t b, Move (&out)[3]) const;
+  bool removable(uint32_t u, uint32_t v) const;
+  void apply(const Move& m);
+  void recount(uint32_t v);
+  void rebuild_grid();
+  void compact();
+  // collapse_checks.cpp
+  bool try_move(const Move& m);
+  bool topology_ok(uint32_t u, uint32_t v);
+  bool shape_ok(const Move& m, const Vec3& qi);
+  bool error_ok(const Move& m);
+  bool samples_ok(const Move& m, const Vec3& qi) const;
+  bool clash_free(const Move& m, const Vec3& qi) const;
+  void box_of(uint32_t f, Vec3& lo, Vec3& hi) const;
+  Vec3 at_index(uint32_t w, const Move& m, const Vec3& qi) const { return w == m.u || w == m.v ? qi : xi[w]; }
+  Vec3 at_phys(uint32_t w, const Move& m) const { return w == m.u || w == m.v ? m.q : xp[w]; }
+
+  Mesh& mesh;
+  const SimplifyOptions& o;
+  SimplifyStats st;
+  std::vector<Vec3> xp, xi, input;  // physical, index space, the input's physical positions
+  std::vector<Triangle>& tri;
+  std::vector<std::vector<uint32_t>> vf;  // faces around each vertex
+  std::vector<uint8_t> face_alive, vertex_alive, moved;
+  std::vector<uint32_t> stamp;
+  std::vector<Quadric> Q;
+  std::unordered_map<uint64_t, uint8_t> feature;  // edge key -> kSharp | kBorder
+  std::vector<uint8_t> fdeg;                       // feature edges at each vertex (capped at 255)
+  std::vector<std::vector<uint32_t>> attached;     // per face: removed input vertices nearest to it
+  mutable FaceGrid grid;  // its query marks the faces it reports
+  uint64_t grid_faces = 0;  // alive faces when the grid was last built
+  double delta = 0;                                // index-space clearance
+  Vec3 sample_lo, sample_hi;                       // the samples that exist (the lattice and its padding ring)
+  uint64_t alive_faces = 0;
+  // Scratch of the move being checked.
+  std::vector<uint32_t> ring, shared, nu, nv_, common;
+  std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face) of the accepted error check
+  double move_error = 0;
+};
+
+}  // namespace voxpress::detail
