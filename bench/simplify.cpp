@@ -9,6 +9,9 @@
 //
 //   build/bench/bench_simplify --shape cad-part --res 128 --rotate random:1
 //   build/bench/bench_simplify --model ../shared/data/meshes/fandisk.off --res 128
+//   build/bench/bench_simplify --volume ../shared/data/medical/totalseg_aorta.nii.gz
+// A real volume has no truth: its rows measure against the unsimplified
+// pressed surface instead.
 #include <meshoptimizer.h>
 
 #include <CLI/CLI.hpp>
@@ -100,11 +103,12 @@ Row measure(const std::string& who, const Mesh& m, double seconds, const Truth& 
 
 int main(int argc, char** argv) {
   CLI::App app{"voxpress's simplifier against meshopt_simplify at the same face counts"};
-  std::string shape = "cad-part", model, rotate = "random:1", ratios_arg = "0.1,0.02,0.005";
+  std::string shape = "cad-part", model, volume_file, rotate = "random:1", ratios_arg = "0.1,0.02,0.005";
   int64_t res = 128;
   size_t samples = 100000;
   app.add_option("--shape", shape, "Generated shape (sphere, torus, box, cylinder, cad-part)")->capture_default_str();
   app.add_option("--model", model, "A closed mesh to voxelize instead (its own truth)");
+  app.add_option("--volume", volume_file, "A real volume (mask): measured against its unsimplified pressed surface");
   app.add_option("--res", res, "Resolution")->capture_default_str();
   app.add_option("--rotate", rotate, "Rotation (random:N, AX,AY,AZ or none)")->capture_default_str();
   app.add_option("--ratios", ratios_arg, "Face ratios")->capture_default_str();
@@ -114,7 +118,10 @@ int main(int argc, char** argv) {
   BinaryVolume volume;
   std::unique_ptr<Truth> truth;
   std::string name;
-  if (!model.empty()) {
+  if (!volume_file.empty()) {
+    volume = binarize(read_volume(volume_file), Selection{});
+    name = volume_file;
+  } else if (!model.empty()) {
     const Mesh m = read_mesh(model);
     VoxelizeOptions vo;
     vo.res = res;
@@ -139,6 +146,7 @@ int main(int argc, char** argv) {
   const SurfaceResult pressed = smooth_surface(volume);
   const double press_seconds = seconds_since(t0);
   const Mesh& full = pressed.mesh;
+  if (!truth) truth = mesh_truth(full, "the pressed surface");
   std::vector<Row> rows{measure("pressed", full, press_seconds, *truth, volume, samples)};
   for (double ratio : split(ratios_arg)) {
     const uint64_t faces = uint64_t(ratio * double(full.triangles.size()));

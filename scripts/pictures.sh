@@ -24,6 +24,13 @@ mkdir -p "$img"
 "$vp" -q press "$work/plate.nrrd" -o "$work/plate-walls.ply"
 "$vp" render "$work/plate-no-walls.ply" "$work/plate-walls.ply" --color regions --size 480x400 -o "$img/thin-plate.png"
 
+# The same part at 256^3, pressed (432 k triangles) and simplified to 2 % of them (--faces 8644),
+# triangle edges drawn: the flats become a few large triangles, every sample still on its side.
+"$vp" -q generate cad-part --res 256 --rotate random:7 -o "$work/part256.nrrd"
+"$vp" -q press "$work/part256.nrrd" -o "$work/part256.ply"
+"$vp" -q press "$work/part256.nrrd" -o "$work/part256-2pc.ply" --faces 8644
+"$vp" render "$work/part256.ply" "$work/part256-2pc.ply" --color regions --wireframe --size 480x400 -o "$img/simplified.png"
+
 if [ -d "$shared/medical" ]; then
   # A CT segmentation (TotalSegmentator's aorta, 1.5 mm): input voxels vs Pressing.
   "$vp" render "$shared/medical/totalseg_aorta.nii.gz" "$shared/medical/totalseg_aorta.nii.gz" \

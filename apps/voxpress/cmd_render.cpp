@@ -47,7 +47,7 @@ namespace {
 struct RenderCmd {
   std::vector<std::string> inputs;
   std::string output, view = "iso", size = "800x600", color = "auto", method;
-  bool no_features = false;
+  bool no_features = false, wireframe = false;
   InputOptions in;
 };
 
@@ -68,6 +68,7 @@ void run_render(const RenderCmd& c, const Global& g) {
   else if (c.color != "auto")
     throw UsageError("--color must be auto, regions or plain");
   o.features = !c.no_features;
+  o.wireframe = c.wireframe;
   // One method for every input, or one per input.
   std::vector<std::string> methods;
   {
@@ -143,6 +144,7 @@ void register_render(CLI::App& app, Global& g) {
                   "One for all inputs or one per input (comma-separated). Volumes: voxels, midpoint, or a press "
                   "method (default pressing); voxel art: voxels, lanczos (default), taubin, pressing");
   cmd->add_flag("--no-features", c->no_features, "Do not draw the sharp feature curves");
+  cmd->add_flag("--wireframe", c->wireframe, "Also draw every triangle's edges (thin, grey)");
   c->in.bind(*cmd);
   cmd->callback([c, &g] {
     g.apply();

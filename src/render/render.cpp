@@ -180,31 +180,36 @@ Texture render_mesh(const Mesh& mesh, const RenderOptions& o) {
         }
     }
 
-    // Feature curves: dark strokes about 1.6 output pixels wide, drawn where
-    // they are not behind the surface (a depth tolerance of 0.4 % of the depth range).
-    if (o.features && !mesh.edges.empty()) {
-      const double tol = 0.004 * std::max(z1 - z0, 1e-12), radius = 0.8 * ss;
+    // Strokes drawn where they are not behind the surface (a depth
+    // tolerance of 0.4 % of the depth range): the triangles' edges thin and
+    // grey (wireframe), the feature curves dark, about 1.6 output pixels wide.
+    const double tol = 0.004 * std::max(z1 - z0, 1e-12);
+    const auto stroke = [&](const Vec3& a, const Vec3& b, double radius, std::array<uint8_t, 3> rgb) {
       const int64_t r = int64_t(std::ceil(radius));
-      for (const auto& e : mesh.edges) {
-        const auto &a = s[e[0]], &b = s[e[1]];
-        const double len = std::hypot(b.x() - a.x(), b.y() - a.y());
-        const int steps = std::max(1, int(std::ceil(len / (0.5 * ss))));
-        for (int k = 0; k <= steps; ++k) {
-          const double u = double(k) / steps;
-          const double px = a.x() + u * (b.x() - a.x()), py = a.y() + u * (b.y() - a.y());
-          const double pz = a.z() + u * (b.z() - a.z());
-          for (int64_t dy = -r; dy <= r; ++dy)
-            for (int64_t dx = -r; dx <= r; ++dx) {
-              const int64_t x = int64_t(std::floor(px)) + dx, y = int64_t(std::floor(py)) + dy;
-              if (x < 0 || y < 0 || x >= W || y >= H) continue;
-              if (std::hypot(double(x) + 0.5 - px, double(y) + 0.5 - py) > radius) continue;
-              const size_t p = size_t(y * W + x);
-              if (pz + tol < double(depth[p])) continue;
-              color[3 * p] = 25, color[3 * p + 1] = 25, color[3 * p + 2] = 35;
-            }
-        }
+      const double len = std::hypot(b.x() - a.x(), b.y() - a.y());
+      const int steps = std::max(1, int(std::ceil(len / (0.5 * ss))));
+      for (int k = 0; k <= steps; ++k) {
+        const double u = double(k) / steps;
+        const double px = a.x() + u * (b.x() - a.x()), py = a.y() + u * (b.y() - a.y());
+        const double pz = a.z() + u * (b.z() - a.z());
+        for (int64_t dy = -r; dy <= r; ++dy)
+          for (int64_t dx = -r; dx <= r; ++dx) {
+            const int64_t x = int64_t(std::floor(px)) + dx, y = int64_t(std::floor(py)) + dy;
+            if (x < 0 || y < 0 || x >= W || y >= H) continue;
+            if (std::hypot(double(x) + 0.5 - px, double(y) + 0.5 - py) > radius) continue;
+            const size_t p = size_t(y * W + x);
+            if (pz + tol < double(depth[p])) continue;
+            color[3 * p] = rgb[0], color[3 * p + 1] = rgb[1], color[3 * p + 2] = rgb[2];
+          }
       }
-    }
+    };
+    if (o.wireframe)
+      for (const Triangle& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k)
+          if (t[size_t(k)] < t[size_t((k + 1) % 3)])  // each edge once (closed meshes)
+            stroke(s[t[size_t(k)]], s[t[size_t((k + 1) % 3)]], 0.35 * ss, {90, 96, 110});
+    if (o.features)
+      for (const auto& e : mesh.edges) stroke(s[e[0]], s[e[1]], 0.8 * ss, {25, 25, 35});
   }
   // Box filter down to the output size.
   for (int64_t y = 0; y < o.height; ++y)

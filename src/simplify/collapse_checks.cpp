@@ -41,27 +41,50 @@ bool swept(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec
          point_triangle_distance2(z, a, b, c) <= reach2 || point_triangle_distance2(z, a, b, d) <= reach2;
 }
 
-// Do the corners of b that a does not share lie on one side of a's plane,
-// each farther than d from it? Then b meets a only where they share, and
-// no part of b is within d of a beyond that: the exact test can be skipped
-// when this holds both ways (2d: a margin for the rounding of the test).
-bool beside(const Vec3 (&a)[3], const Vec3& na, const uint32_t (&ia)[3], const Vec3 (&b)[3], const uint32_t (&ib)[3],
-            double d) {
-  int side = 0;
-  for (int k = 0; k < 3; ++k) {
-    if (ib[k] == ia[0] || ib[k] == ia[1] || ib[k] == ia[2]) continue;
-    const double h = na.dot(b[k] - a[0]);
-    const int s = h > 2 * d ? 1 : h < -2 * d ? -1 : 0;
-    if (s == 0 || (side != 0 && s != side)) return false;
-    side = s;
+// A triangle with what the clash test needs: corners, vertex ids, box
+// (grown by the clearance), unit normal and its edges' outward in-plane
+// unit normals.
+struct ClashFace {
+  Vec3 x[3];
+  uint32_t id[3];
+  Vec3 lo, hi, n, m[3];
+  void prepare(double d) {
+    lo = x[0].cwiseMin(x[1]).cwiseMin(x[2]).array() - d;
+    hi = x[0].cwiseMax(x[1]).cwiseMax(x[2]).array() + d;
+    n = (x[1] - x[0]).cross(x[2] - x[0]);
+    const double l = n.norm();
+    n = l > 0 ? Vec3(n / l) : Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      m[k] = (x[(k + 1) % 3] - x[k]).cross(n);  // outwards for a counter-clockwise triangle about n
+      const double lm = m[k].norm();
+      m[k] = lm > 0 ? Vec3(m[k] / lm) : Vec3::Zero();
+    }
   }
-  return true;
-}
+  bool shares(uint32_t w) const { return w == id[0] || w == id[1] || w == id[2]; }
+};
 
-Vec3 unit_normal(const Vec3 (&t)[3]) {
-  const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
-  const double l = n.norm();
-  return l > 0 ? Vec3(n / l) : Vec3::Zero();
+// Is there a plane with triangle a on one side and the corners of b that a
+// does not share beyond it, each farther than 2d (d, and as much again for
+// the rounding of the test)? The planes tried: a's own (either side) and
+// the three through a's edges perpendicular to it (outwards), so coplanar
+// neighbours on a flat are told apart too. When this holds both ways, b
+// meets a only where they share and nothing else of either is within d of
+// the other: triangles_clash need not run. Disjoint triangles need it one
+// way only (any separating plane will do).
+bool apart(const ClashFace& a, const ClashFace& b, double d) {
+  int own[3], n = 0;
+  for (int k = 0; k < 3; ++k)
+    if (!a.shares(b.id[k])) own[n++] = k;
+  if (n == 0 || a.n == Vec3::Zero()) return false;
+  const auto beyond = [&](const Vec3& m, const Vec3& p, double sign) {
+    for (int k = 0; k < n; ++k)
+      if (sign * m.dot(b.x[own[k]] - p) <= 2 * d) return false;
+    return true;
+  };
+  if (beyond(a.n, a.x[0], 1) || beyond(a.n, a.x[0], -1)) return true;
+  for (int k = 0; k < 3; ++k)
+    if (beyond(a.m[k], a.x[k], 1)) return true;
+  return false;
 }
 
 void sorted_neighbours(const std::vector<std::vector<uint32_t>>& vf, const std::vector<Triangle>& tri, uint32_t v,
@@ -229,51 +252,51 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi) const {
 // The new faces neither meet nor come within the clearance of each other or
 // of any other face.
 bool Collapser::clash_free(const Move& m, const Vec3& qi) const {
-  struct Face {
-    Vec3 x[3];
-    uint32_t id[3];
-    Vec3 lo, hi, n;
-  };
-  Face nf[64];
+  ClashFace nf[64];
   int n = 0;
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   for (uint32_t f : ring) {
     if (f == shared[0] || f == shared[1]) continue;
     if (n == 64) return false;  // a vertex of over 60 faces: not worth the check
-    Face& g = nf[n++];
+    ClashFace& g = nf[n++];
     for (int c = 0; c < 3; ++c) {
       const uint32_t w = tri[f][size_t(c)];
       g.x[c] = at_index(w, m, qi);
       g.id[c] = w == m.u ? m.v : w;
     }
-    g.n = unit_normal(g.x);
-    g.lo = g.x[0].cwiseMin(g.x[1]).cwiseMin(g.x[2]).array() - delta;
-    g.hi = g.x[0].cwiseMax(g.x[1]).cwiseMax(g.x[2]).array() + delta;
+    g.prepare(delta);
     lo = lo.cwiseMin(g.lo);
     hi = hi.cwiseMax(g.hi);
   }
-  const auto overlap = [](const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
-    return !((alo.array() > bhi.array()).any() || (blo.array() > ahi.array()).any());
+  const auto overlap = [](const ClashFace& a, const Vec3& blo, const Vec3& bhi) {
+    return !((a.lo.array() > bhi.array()).any() || (blo.array() > a.hi.array()).any());
   };
-  const auto clash = [&](const Face& a, const Vec3 (&bx)[3], const uint32_t (&bi)[3], const Vec3& bn) {
-    if (beside(a.x, a.n, a.id, bx, bi, delta) && beside(bx, bn, bi, a.x, a.id, delta)) return false;
-    return triangles_clash(a.x, a.id, bx, bi, delta);
+  const auto clash = [&](const ClashFace& a, const ClashFace& b) {
+    // Disjoint triangles need one separating plane; sharing a vertex, both.
+    const bool disjoint = !a.shares(b.id[0]) && !a.shares(b.id[1]) && !a.shares(b.id[2]);
+    const bool ab = apart(a, b, delta);
+    if (ab && disjoint) return false;
+    if ((ab || disjoint) && apart(b, a, delta)) return false;
+    return triangles_clash(a.x, a.id, b.x, b.id, delta);
   };
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j)
-      if (overlap(nf[i].lo, nf[i].hi, nf[j].lo, nf[j].hi) && clash(nf[i], nf[j].x, nf[j].id, nf[j].n)) return false;
+      if (overlap(nf[i], nf[j].lo, nf[j].hi) && clash(nf[i], nf[j])) return false;
   bool clashed = false;
   grid.query(lo, hi, [&](uint32_t g) {
     if (clashed || std::binary_search(ring.begin(), ring.end(), g)) return;
     const Triangle& t = tri[g];
-    const Vec3 gx[3] = {xi[t[0]], xi[t[1]], xi[t[2]]};
-    const uint32_t gi[3] = {t[0], t[1], t[2]};
-    const Vec3 glo = gx[0].cwiseMin(gx[1]).cwiseMin(gx[2]), ghi = gx[0].cwiseMax(gx[1]).cwiseMax(gx[2]);
-    Vec3 gn = Vec3::Zero();
+    ClashFace c;
+    for (int k = 0; k < 3; ++k) {
+      c.x[k] = xi[t[size_t(k)]];
+      c.id[k] = t[size_t(k)];
+    }
+    const Vec3 glo = c.x[0].cwiseMin(c.x[1]).cwiseMin(c.x[2]), ghi = c.x[0].cwiseMax(c.x[1]).cwiseMax(c.x[2]);
+    bool ready = false;
     for (int i = 0; i < n && !clashed; ++i) {
-      if (!overlap(nf[i].lo, nf[i].hi, glo, ghi)) continue;
-      if (gn == Vec3::Zero()) gn = unit_normal(gx);
-      clashed = clash(nf[i], gx, gi, gn);
+      if (!overlap(nf[i], glo, ghi)) continue;
+      if (!ready) c.prepare(0), ready = true;
+      clashed = clash(nf[i], c);
     }
   });
   return !clashed;

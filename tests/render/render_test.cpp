@@ -120,6 +120,36 @@ TEST(Render, ColoursRegionsTexturesAndFeatures) {
   EXPECT_THROW(parse_view("top"), UsageError);
 }
 
+// --wireframe draws the triangles' edges: a box's voxel faces seen along z
+// show one grey line per row and column of cells, nothing outside it.
+TEST(Render, WireframeDrawsTheTrianglesEdges) {
+  const Mesh m = voxel_faces(box_volume({12, 12, 12}, {2, 2, 2}, {9, 9, 9}));
+  RenderOptions o;
+  o.view = View::z;
+  o.width = o.height = 200;
+  const Texture plain = render_mesh(m, o);
+  o.wireframe = true;
+  const Texture wire = render_mesh(m, o);
+  const Ink a = ink(plain), b = ink(wire);
+  EXPECT_NEAR(double(a.x0), double(b.x0), 2);  // the outline's strokes may add a pixel
+  EXPECT_NEAR(double(a.x1), double(b.x1), 2);
+  EXPECT_NEAR(double(a.y1), double(b.y1), 2);
+  // Stroke-dark pixels along a row through the box (the face is far
+  // lighter): one run per edge line crossed.
+  const int64_t y = 100;
+  int darker = 0, runs = 0;
+  bool in_run = false;
+  for (int64_t x = 0; x < 200; ++x) {
+    const size_t p = size_t(y * 200 + x) * 4;
+    const bool dark = wire.rgba[p] < 120 && plain.rgba[p] > 150;
+    darker += dark;
+    runs += dark && !in_run;
+    in_run = dark;
+  }
+  EXPECT_GT(darker, 0);
+  EXPECT_GE(runs, 8);  // 8 cells across (the edges between cells and the two sides; diagonals add more)
+}
+
 TEST(Render, RegionColoursAreDistinctForNeighbouringIds) {
   for (int64_t r = 0; r < 40; ++r) {
     const auto a = region_color(r), b = region_color(r + 1);

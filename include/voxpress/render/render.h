@@ -33,6 +33,7 @@ struct RenderOptions {
   View view = View::iso;
   Coloring coloring = Coloring::automatic;
   bool features = true;  ///< draw Mesh::edges
+  bool wireframe = false;  ///< draw every triangle's edges (thin, grey)
   int supersample = 3;   ///< samples per pixel along each axis
   std::array<uint8_t, 3> base{190, 198, 215};
   std::array<uint8_t, 3> background{255, 255, 255};
