@@ -20,8 +20,15 @@ void run_extract_labels(const ExtractCmd& c, const Global& g) {
   ProgressBar bar(!g.quiet);
   const ScalarVolume volume = load_volume(c.input, c.in, g);
   const double t_read = clock.seconds();
-  const SharedSurface s = extract_shared_surface(volume);
+  SharedSurface s = extract_shared_surface(volume);
   const double t_extract = clock.seconds() - t_read;
+  const bool simplifying = c.simplify.faces || c.simplify.max_error;
+  SimplifyStats simplified;
+  if (simplifying) {
+    SimplifyOptions so = c.simplify;
+    so.progress = bar.get();
+    simplified = simplify_shared(s, so);
+  }
   nlohmann::json checks = nlohmann::json::array();
   if (c.check)
     for (uint32_t L = 1; L < s.labels.size(); ++L) {
@@ -51,6 +58,7 @@ void run_extract_labels(const ExtractCmd& c, const Global& g) {
     j["vertices"] = {{"sticks", s.stick_vertices}, {"face_centres", s.face_vertices}, {"apexes", s.apex_vertices}};
     j["triangles"] = mesh.face_count();
     j["seconds"] = {{"read", t_read}, {"extract", t_extract}, {"total", clock.seconds()}};
+    if (simplifying) j["simplify"] = simplify_stats_json(simplified, c.simplify);
     j["peak_memory_bytes"] = peak_rss_bytes();
     if (c.check) j["checks"] = checks;
     write_json(c.stats_json, j);
@@ -62,10 +70,7 @@ void run_extract(const ExtractCmd& c, const Global& g) {
 
   mesh_format_from_path(c.output);  // fail on a bad extension before any work
   const bool simplifying = c.simplify.faces || c.simplify.max_error;
-  if (c.labels) {
-    if (simplifying) throw UsageError("--faces and --max-error do not apply with --labels yet");
-    return run_extract_labels(c, g);
-  }
+  if (c.labels) return run_extract_labels(c, g);
   Stopwatch clock;
   ProgressBar bar(!g.quiet);
   const VolumeSurface vs = load_surface(c.input, c.in, g, bar.get());

@@ -185,7 +185,7 @@ Pressed press_chunked_file(const PressCmd& c, const SurfaceOptions& so, const Gl
 void run_press(const PressCmd& c, const Global& g) {
   const bool labels = !c.labels.empty();
   if (labels) {
-    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--halo", "--faces", "--max-error"})
+    for (const char* name : {"--label", "--threshold", "--segment", "--features", "--halo"})
       if (c.cmd->count(name)) throw UsageError(std::string(name) + " does not apply with --labels");
     check_paths({c.input}, {{c.stats_json, OutputKind::json}});
   } else {

@@ -231,6 +231,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
                                    : press_shared_labels(*src.volume, table, so);
       if (src.surface) r.seconds_extract = src.seconds_extract;
       shared_stats = shared_json(r);
+      if (so.simplify.faces || so.simplify.max_error) shared_stats["simplify"] = simplify_stats_json(r.simplify, so.simplify);
       pieces = shared_pieces(r, chosen);
       combined = interfaces_mesh(r.surface);
     } else {

@@ -591,6 +591,7 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
     so.passes = o.passes;
     r.sharpen = sharpen_shared(r.surface, *r.flats, masks, table.labels, so);
   }
+  if (o.simplify.faces || o.simplify.max_error) r.simplify = simplify_shared(r.surface, o.simplify);
   return r;
 }
 

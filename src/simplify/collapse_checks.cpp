@@ -126,30 +126,44 @@ bool Collapser::try_move(const Move& m) {
   return true;
 }
 
-// The link condition (the common neighbours of u and v are exactly the
-// apexes of their two faces), no apex left with three neighbours, no
-// component shrunk below a tetrahedron, no two feature edges merged.
+// The link condition (Dey et al.'s for 2-complexes: the links of u and v
+// meet only in the link of the edge: their common neighbours are exactly
+// the apexes of the edge's two faces, or of its three and more on a
+// junction line, and no face of u spans two of them), no apex left with
+// three neighbours, no component shrunk below a tetrahedron, no two
+// feature edges merged.
 bool Collapser::topology_ok(uint32_t u, uint32_t v) {
   shared.clear();
   for (uint32_t f : vf[u])
     if (tri[f][0] == v || tri[f][1] == v || tri[f][2] == v) shared.push_back(f);
-  if (shared.size() != 2) return false;
+  if (shared.size() < 2) return false;
   sorted_neighbours(vf, tri, u, nu);
   sorted_neighbours(vf, tri, v, nv_);
   common.clear();
   std::set_intersection(nu.begin(), nu.end(), nv_.begin(), nv_.end(), std::back_inserter(common));
-  if (common.size() != 2 || nu.size() + nv_.size() - 2 <= 4) return false;
+  if (common.size() != shared.size() || nu.size() + nv_.size() - 2 <= 4) return false;
+  for (uint32_t f : shared) {  // the apexes are the common neighbours, once each
+    const Triangle& t = tri[f];
+    const uint32_t apex = t[0] != u && t[0] != v ? t[0] : t[1] != u && t[1] != v ? t[1] : t[2];
+    if (!std::binary_search(common.begin(), common.end(), apex)) return false;
+  }
   for (uint32_t w : common) {
     if (vf[w].size() <= 3) return false;
     const bool fu = feature.count(key(u, w)) != 0, fv = feature.count(key(v, w)) != 0;
     if (fu && fv) return false;
+  }
+  for (uint32_t f : vf[u]) {
+    if (is_shared(f)) continue;
+    int in_common = 0;
+    for (uint32_t w : tri[f]) in_common += w != u && std::binary_search(common.begin(), common.end(), w);
+    if (in_common == 2) return false;
   }
   return true;
 }
 
 bool Collapser::shape_ok(const Move& m, const Vec3& qi) {
   for (uint32_t f : ring) {
-    if (f == shared[0] || f == shared[1]) continue;
+    if (is_shared(f)) continue;
     const Triangle& t = tri[f];
     const Vec3 n0 = (xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]);
     const Vec3 a = at_phys(t[0], m), b = at_phys(t[1], m), c = at_phys(t[2], m);
@@ -170,7 +184,7 @@ bool Collapser::error_ok(const Move& m) {
   auto nearest = [&](const Vec3& p, uint32_t& best) {
     double d2 = INFINITY;
     for (uint32_t f : ring) {
-      if (f == shared[0] || f == shared[1]) continue;
+      if (is_shared(f)) continue;
       const Triangle& t = tri[f];
       const double e = point_triangle_distance2(p, at_phys(t[0], m), at_phys(t[1], m), at_phys(t[2], m));
       if (e < d2) {
@@ -236,7 +250,7 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi) const {
     }
   }
   for (uint32_t f : ring) {
-    if (f == shared[0] || f == shared[1]) continue;
+    if (is_shared(f)) continue;
     const Triangle& t = tri[f];
     const Vec3 a = at_index(t[0], m, qi), b = at_index(t[1], m, qi), c = at_index(t[2], m, qi);
     const Vec3 n = (b - a).cross(c - a).normalized();  // shape_ok: not degenerate
@@ -256,7 +270,7 @@ bool Collapser::clash_free(const Move& m, const Vec3& qi) const {
   int n = 0;
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   for (uint32_t f : ring) {
-    if (f == shared[0] || f == shared[1]) continue;
+    if (is_shared(f)) continue;
     if (n == 64) return false;  // a vertex of over 60 faces: not worth the check
     ClashFace& g = nf[n++];
     for (int c = 0; c < 3; ++c) {

@@ -103,8 +103,9 @@ void Collapser::build() {
   attached.assign(nf, {});
   alive_faces = nf;
 
-  // Edges from sorted half-edges: each must have exactly two faces, in
-  // opposite directions (a closed, oriented 2-manifold).
+  // Edges from sorted half-edges: each must have two faces in opposite
+  // directions (a closed, oriented 2-manifold) or, with junctions, three
+  // or more (a junction line of a shared surface: a feature edge).
   struct Half {
     uint64_t key;
     uint32_t face;
@@ -119,14 +120,16 @@ void Collapser::build() {
     }
   std::sort(he.begin(), he.end(), [](const Half& x, const Half& y) { return std::tie(x.key, x.face) < std::tie(y.key, y.face); });
   std::vector<uint64_t> edges;
-  for (size_t i = 0; i < he.size(); i += 2) {
-    if (i + 1 >= he.size() || he[i + 1].key != he[i].key || he[i].forward == he[i + 1].forward ||
-        (i + 2 < he.size() && he[i + 2].key == he[i].key))
-      throw std::invalid_argument("simplify: the mesh is not a closed, oriented 2-manifold");
+  for (size_t i = 0, j = 0; i < he.size(); i = j) {
+    while (j < he.size() && he[j].key == he[i].key) ++j;
+    const size_t k = j - i;
+    if (k < 2 || (k == 2 && he[i].forward == he[i + 1].forward) || (k > 2 && !o.junctions))
+      throw std::invalid_argument(o.junctions ? "simplify: the surface has an open or misoriented edge"
+                                              : "simplify: the mesh is not a closed, oriented 2-manifold");
     edges.push_back(he[i].key);
-    const uint32_t f = he[i].face, g = he[i + 1].face;
-    bool hard = false;
-    for (const MeshAttribute& at : mesh.face_attributes) hard |= at.values[f] != at.values[g];
+    bool hard = k > 2;
+    for (const MeshAttribute& at : mesh.face_attributes)
+      for (size_t h = i + 1; h < j; ++h) hard |= at.values[he[h].face] != at.values[he[i].face];
     if (hard) feature[he[i].key] |= kBorder;
   }
   he = {};
@@ -167,8 +170,20 @@ void Collapser::build() {
   fdeg.assign(nv, 0);
   for (const auto& [k, flags] : feature) {
     const uint32_t a = uint32_t(k >> 32), b = uint32_t(k);
-    fdeg[a] = uint8_t(std::min(255, fdeg[a] + 1));
-    fdeg[b] = uint8_t(std::min(255, fdeg[b] + 1));
+    fdeg[a] = uint8_t(std::min(254, fdeg[a] + 1));
+    fdeg[b] = uint8_t(std::min(254, fdeg[b] + 1));
+  }
+  // A vertex off every feature whose faces are not one disc (as many faces
+  // as neighbours) is a pinch: it stays.
+  std::vector<uint32_t> around;
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (fdeg[v] != 0) continue;
+    around.clear();
+    for (uint32_t f : vf[v])
+      for (uint32_t w : tri[f])
+        if (w != v) around.push_back(w);
+    std::sort(around.begin(), around.end());
+    if (size_t(std::unique(around.begin(), around.end()) - around.begin()) != vf[v].size()) fdeg[v] = kPinned;
   }
   rebuild_grid();
 }
@@ -219,11 +234,16 @@ int Collapser::moves(uint32_t a, uint32_t b, Move (&out)[3]) const {
 }
 
 void Collapser::recount(uint32_t v) {
-  int n = 0;
+  if (fdeg[v] == kPinned) return;
+  std::vector<uint32_t> around;
   for (uint32_t f : vf[v])
     for (uint32_t w : tri[f])
-      if (w != v && feature.count(key(v, w))) ++n;
-  fdeg[v] = uint8_t(std::min(255, n / 2));  // each edge is seen from its two faces
+      if (w != v) around.push_back(w);
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  int n = 0;
+  for (uint32_t w : around) n += feature.count(key(v, w)) != 0;
+  fdeg[v] = uint8_t(std::min(254, n));
 }
 
 void Collapser::box_of(uint32_t f, Vec3& lo, Vec3& hi) const {
@@ -292,13 +312,17 @@ void Collapser::apply(const Move& m) {
   ++st.collapses;
 }
 
-SimplifyStats Collapser::run() {
+SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
   const auto t0 = std::chrono::steady_clock::now();
   st.faces_before = tri.size();
   const bool bounded = o.max_error > 0;
   if (o.faces == 0 && !bounded) {  // nothing asked
     st.faces_after = tri.size();
     st.vertices_after = mesh.positions.size();
+    if (vertex_map) {
+      vertex_map->resize(mesh.positions.size());
+      for (uint32_t v = 0; v < vertex_map->size(); ++v) (*vertex_map)[v] = v;
+    }
     return st;
   }
   build();
@@ -342,7 +366,7 @@ SimplifyStats Collapser::run() {
         break;
       }
   }
-  compact();
+  compact(vertex_map);
   // The error: the farthest input vertex from the result (order-free max).
   if (st.collapses > 0) {
     const MeshQuery query(mesh);
@@ -362,7 +386,7 @@ SimplifyStats Collapser::run() {
   return st;
 }
 
-void Collapser::compact() {
+void Collapser::compact(std::vector<uint32_t>* vertex_map) {
   const size_t nv = xp.size(), nf = tri.size();
   std::vector<uint32_t> remap(nv, UINT32_MAX);
   uint32_t next = 0;
@@ -396,20 +420,21 @@ void Collapser::compact() {
     if (flags & kSharp) mesh.edges.push_back({remap[uint32_t(e >> 32)], remap[uint32_t(e)]});
   std::sort(mesh.edges.begin(), mesh.edges.end());
   if (!mesh.normals.empty()) mesh.normals = vertex_normals(mesh);
+  if (vertex_map) *vertex_map = std::move(remap);
 }
 
 }  // namespace voxpress::detail
 
 namespace voxpress {
 
-SimplifyStats simplify(Mesh& mesh, const SimplifyOptions& options) {
+SimplifyStats simplify(Mesh& mesh, const SimplifyOptions& options, std::vector<uint32_t>* vertex_map) {
   if (!options.soft_keys.empty() && options.soft_keys.size() != mesh.triangles.size())
     throw std::invalid_argument("simplify: soft_keys must have one key per face");
   if (!(options.max_error >= 0) || !std::isfinite(options.max_error))
     throw std::invalid_argument("simplify: max_error must be finite and non-negative");
   mesh.validate();
   detail::Collapser c(mesh, options);
-  return c.run();
+  return c.run(vertex_map);
 }
 
 }  // namespace voxpress

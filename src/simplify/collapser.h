@@ -10,6 +10,7 @@
 // clearance of the final triangles, means every sample keeps its side.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -34,7 +35,7 @@ struct Quadric {
 class Collapser {
  public:
   Collapser(Mesh& mesh, const SimplifyOptions& options);
-  SimplifyStats run();
+  SimplifyStats run(std::vector<uint32_t>* vertex_map);
 
  private:
   /// Remove u, keep v at q (physical).
@@ -48,7 +49,8 @@ class Collapser {
     uint32_t a, b, sa, sb;
     bool operator<(const Entry& o) const;  // a max-heap of this order pops the cheapest
   };
-  enum : uint8_t { kSharp = 1, kBorder = 2 };  // feature edge flags
+  enum : uint8_t { kSharp = 1, kBorder = 2 };  // feature edge flags (a junction edge is a border)
+  static constexpr uint8_t kPinned = 255;      // fdeg of a vertex that never moves (a pinch)
   static uint64_t key(uint32_t a, uint32_t b) { return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a; }
 
   // collapser.cpp
@@ -59,7 +61,8 @@ class Collapser {
   void apply(const Move& m);
   void recount(uint32_t v);
   void rebuild_grid();
-  void compact();
+  void compact(std::vector<uint32_t>* vertex_map);
+  bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
   // collapse_checks.cpp
   bool try_move(const Move& m);
   bool topology_ok(uint32_t u, uint32_t v);

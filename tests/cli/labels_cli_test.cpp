@@ -32,11 +32,9 @@ TEST(Cli, SharedLabelMapsPerLabel) {
   EXPECT_NE(out.find("4242"), std::string::npos);
 }
 
-// press --labels: one mesh per label into a folder, each read back and
-// checked against the whole volume for its own label; names from a table;
-// bad requests leave no folder at all.
-TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
-  test::TempDir tmp;
+// A block (7), a ball (300) in a block (12), on an anisotropic lattice:
+// three labels and the background, junction lines where they meet.
+void write_three_labels(const std::string& path) {
   ScalarVolume v;
   v.lattice.dims = {20, 18, 16};
   v.lattice.spacing = Vec3(1, 1, 1.5);
@@ -49,7 +47,44 @@ TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
         const double x = i - 10.0, y = j - 9.0, z = (k - 8.0) * 1.5;
         w[v.lattice.linear(i, j, k)] = x < 0 ? 7 : (x * x + y * y + z * z < 36 ? 300 : 12);
       }
-  write_volume(tmp.path("map.nrrd"), v);
+  write_volume(path, v);
+}
+
+// press --labels --faces: the shared surface simplified once; every label's
+// file, read back, checked against the map; extract --labels --faces too.
+TEST(Cli, PressLabelsFacesSimplifiesTheSharedSurfaceOnce) {
+  test::TempDir tmp;
+  write_three_labels(tmp.path("map.nrrd"));
+  std::string out;
+  ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all -o " + tmp.path("o") +
+                        " --faces 900 --check --stats-json " + tmp.path("s.json"),
+                    &out),
+            0)
+      << out;
+  const auto st = nlohmann::json::parse(test::read_file(tmp.path("s.json")));
+  EXPECT_LE(st["shared_surface"]["simplify"]["faces"].get<uint64_t>(), 900u);
+  EXPECT_GT(st["shared_surface"]["simplify"]["faces_before"].get<uint64_t>(), 2000u);
+  EXPECT_EQ(st["interfaces"]["triangles"], st["shared_surface"]["simplify"]["faces"]);
+  for (const auto& e : st["labels"])
+    EXPECT_EQ(run_cli("check " + tmp.path("o/" + e["file"].get<std::string>()) + " --volume " + tmp.path("map.nrrd") +
+                          " --label " + std::to_string(e["value"].get<int>()),
+                      &out),
+              0)
+        << out;
+  ASSERT_EQ(run_cli("-q extract " + tmp.path("map.nrrd") + " --labels -o " + tmp.path("mid.ply") +
+                        " --faces 900 --check --stats-json " + tmp.path("m.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_LE(nlohmann::json::parse(test::read_file(tmp.path("m.json")))["triangles"].get<uint64_t>(), 900u);
+}
+
+// press --labels: one mesh per label into a folder, each read back and
+// checked against the whole volume for its own label; names from a table;
+// bad requests leave no folder at all.
+TEST(Cli, PressLabelsWritesOneCheckedMeshPerLabel) {
+  test::TempDir tmp;
+  write_three_labels(tmp.path("map.nrrd"));
   test::write_file(tmp.path("names.txt"), "7 left block\n300 ball\n");
   std::string out;
   ASSERT_EQ(run_cli("-q press " + tmp.path("map.nrrd") + " --labels all --label-names " + tmp.path("names.txt") +

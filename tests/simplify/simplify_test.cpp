@@ -11,6 +11,7 @@
 #include <map>
 
 #include "eval/mesh_query.h"
+#include "labels/label_volumes.h"
 #include "test_util.h"
 
 namespace voxpress {
@@ -182,6 +183,25 @@ TEST(Simplify, SameBytesForAnyThreadCount) {
   EXPECT_EQ(one.positions, two.positions);
   EXPECT_EQ(one.triangles, two.triangles);
   EXPECT_EQ(one.edges, two.edges);
+}
+
+// Junction lines (edges of three and more faces): a label map's shared
+// midpoint surface, simplified with junctions allowed, keeps every label
+// closed and every sample on its side; without the option it is refused.
+TEST(Simplify, JunctionLinesOfASharedSurface) {
+  const ScalarVolume v = test::phantom();
+  SharedSurface s = extract_shared_surface(v);
+  SimplifyOptions o;
+  o.faces = s.mesh.face_count() / 5;
+  Mesh m = s.mesh;
+  o.lattice = &s.lattice;
+  EXPECT_THROW(simplify(m, o), std::invalid_argument);
+  const SimplifyStats st = simplify_shared(s, o);
+  EXPECT_LE(st.faces_after, o.faces);
+  for (uint32_t L = 1; L < s.labels.size(); ++L) {
+    SCOPED_TRACE("label " + std::to_string(s.labels[L]));
+    test::expect_guarantees(label_mesh(s, L), test::whole_mask(v, double(s.labels[L])));
+  }
 }
 
 TEST(Simplify, RefusesWhatIsNotAClosedManifoldAndNoTargetIsANoOp) {

@@ -82,6 +82,7 @@ struct SharedLabels {
   SharedPressStats press;
   SharedFitStats fit;          ///< when options.passes has Pass::quadric_fit
   SharedSharpenStats sharpen;  ///< labels with flats, when options.passes has Pass::sharpen
+  SimplifyStats simplify;      ///< with options.simplify (faces: the shared surface's triangles)
   double seconds_extract = 0;
 };
 SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& options);

@@ -22,6 +22,7 @@
 
 #include "voxpress/core/mesh.h"
 #include "voxpress/core/volume.h"
+#include "voxpress/simplify/simplify.h"
 
 namespace voxpress {
 
@@ -78,6 +79,13 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
 /// ones it is `out` of reversed), vertices renumbered in order of the
 /// shared mesh. Vertex positions are bit-identical to the shared mesh's.
 Mesh label_mesh(const SharedSurface& surface, uint32_t label);
+
+/// Simplifies the shared surface once (simplify() on its lattice, junction
+/// lines and label-pair borders kept as edges): both labels of an interface
+/// keep the same triangles, each label's surface stays closed and 2-manifold
+/// and every sample stays on its side. Per-vertex kind and corner follow the
+/// surviving vertices (a simplified surface is no longer pressed further).
+SimplifyStats simplify_shared(SharedSurface& surface, const SimplifyOptions& options);
 
 /// The whole shared surface, each interface once, with face attributes
 /// label_in and label_out (the label values on either side; PLY keeps them).

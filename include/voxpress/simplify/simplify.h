@@ -38,6 +38,9 @@ struct SimplifyOptions {
   /// colours: the plane through the border, perpendicular to each face, is
   /// added to the quadrics). Empty: none.
   std::vector<uint32_t> soft_keys;
+  /// Accept edges of three or more faces (a label map's shared surface:
+  /// its junction lines), kept as feature edges like the borders.
+  bool junctions = false;
   Progress* progress = nullptr;
 };
 
@@ -61,7 +64,10 @@ struct SimplifyStats {
 /// data of the surviving vertices (colours, attributes, texture coordinates)
 /// is kept, face attributes are kept per surviving face, normals are
 /// recomputed, mesh.edges keep the labelled edges that survive. Throws
-/// std::invalid_argument for a mesh that is not a closed 2-manifold.
-SimplifyStats simplify(Mesh& mesh, const SimplifyOptions& options);
+/// std::invalid_argument for a mesh that is not a closed 2-manifold (or,
+/// with options.junctions, one whose every edge has two faces wound
+/// oppositely or three and more). `vertex_map`, when given, receives per
+/// input vertex its output index or UINT32_MAX (removed).
+SimplifyStats simplify(Mesh& mesh, const SimplifyOptions& options, std::vector<uint32_t>* vertex_map = nullptr);
 
 }  // namespace voxpress
