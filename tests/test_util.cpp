@@ -183,6 +183,16 @@ BinaryVolume checkerboard(std::array<int64_t, 3> d, int period_axes) {
   return v;
 }
 
+BinaryVolume far_anisotropic_part(int64_t res) {
+  GenerateOptions g;
+  g.res = res;
+  g.rotation = parse_rotation("random:3");
+  BinaryVolume v = generate_shape(ShapeKind::cad_part, g).volume;
+  v.lattice.spacing = Vec3(0.7, 0.7, 1.9);
+  v.lattice.origin = Vec3(-2500.25, 1800.5, 3100.75);
+  return v;
+}
+
 Mesh rounded_to_float32(Mesh m) {
   for (Vec3& p : m.positions) p = p.cast<float>().cast<double>();
   return m;

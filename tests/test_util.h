@@ -106,6 +106,11 @@ struct Case {
 /// generated volumes (also reused by later methods' property tests).
 std::vector<Case> property_volumes();
 
+/// The CAD part at `res`, rotation random:3, on an anisotropic lattice
+/// (0.7, 0.7, 1.9) far from the origin: a larger float32 rounding to keep
+/// clear of.
+BinaryVolume far_anisotropic_part(int64_t res);
+
 /// The mesh with its positions rounded to float32, as STL and glTF store
 /// them and as most viewers load PLY.
 Mesh rounded_to_float32(Mesh m);

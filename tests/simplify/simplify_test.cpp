@@ -127,15 +127,10 @@ TEST(Simplify, FlatsStayOnTheirPlanesAndSharpEdgesStayEdges) {
 // back, on an anisotropic lattice far from the origin (a larger float32
 // rounding to keep clear of).
 TEST(Simplify, WrittenFilesKeepTheGuarantee) {
-  GenerateOptions g;
-  g.res = 40;
-  g.rotation = parse_rotation("random:3");
-  GeneratedShape part = generate_shape(ShapeKind::cad_part, g);
-  part.volume.lattice.spacing = Vec3(0.7, 0.7, 1.9);
-  part.volume.lattice.origin = Vec3(-2500.25, 1800.5, 3100.75);
+  const BinaryVolume part = test::far_anisotropic_part(40);
   SurfaceOptions so;
   so.simplify.faces = 1500;
-  const SurfaceResult r = smooth_surface(part.volume, so);
+  const SurfaceResult r = smooth_surface(part, so);
   EXPECT_LE(r.mesh.face_count(), 1500u);
   EXPECT_EQ(r.simplify.faces_after, r.mesh.face_count());
   test::TempDir dir;
@@ -145,7 +140,7 @@ TEST(Simplify, WrittenFilesKeepTheGuarantee) {
     write_mesh(path, r.mesh);
     const Mesh back = read_mesh(path);
     ASSERT_EQ(back.face_count(), r.mesh.face_count());
-    test::expect_guarantees(back, part.volume);
+    test::expect_guarantees(back, part);
   }
 }
 

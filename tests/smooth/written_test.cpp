@@ -34,13 +34,7 @@ TEST(Written, RotatedRealMeshKeepsTheGuaranteeInEveryFormat) {
 // A generated part, anisotropic and far from the origin (larger
 // coordinates: a larger float32 rounding to keep clear of).
 TEST(Written, AnisotropicPartFarFromTheOriginKeepsTheGuaranteeInEveryFormat) {
-  GenerateOptions g;
-  g.res = 72;
-  g.rotation = parse_rotation("random:3");
-  GeneratedShape part = generate_shape(ShapeKind::cad_part, g);
-  part.volume.lattice.spacing = Vec3(0.7, 0.7, 1.9);
-  part.volume.lattice.origin = Vec3(-2500.25, 1800.5, 3100.75);
-  expect_every_format_keeps_the_guarantee(part.volume, "cad part 72");
+  expect_every_format_keeps_the_guarantee(test::far_anisotropic_part(72), "cad part 72");
 }
 
 }  // namespace
