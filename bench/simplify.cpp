@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <unistd.h>
 #include <sstream>
 
 #include "voxpress/eval/metrics.h"
@@ -77,6 +78,7 @@ struct Row {
   uint64_t faces = 0;
   double seconds = 0, rms = 0, hausdorff = 0, normal = 0;
   uint64_t violations = 0, intersections = 0;
+  uint64_t stl_violations = 0, stl_intersections = 0;  // the mesh written as STL (float32) and read back
   bool ok = false;
 };
 
@@ -96,6 +98,12 @@ Row measure(const std::string& who, const Mesh& m, double seconds, const Truth& 
   r.violations = e.classification_violations.value_or(0);
   r.intersections = e.mesh.self_intersections;
   r.ok = e.mesh.ok();
+  const std::string stl = "/tmp/bench_simplify_" + std::to_string(::getpid()) + ".stl";
+  write_mesh(stl, m);
+  const Mesh back = read_mesh(stl);
+  std::remove(stl.c_str());
+  r.stl_violations = check_classification(back, volume).violations;
+  r.stl_intersections = check_mesh(back).self_intersections;
   return r;
 }
 
@@ -164,10 +172,11 @@ int main(int argc, char** argv) {
   std::printf("%s, res %lld, rotation %s (%zu faces pressed)\n", name.c_str(), (long long)res, rotate.c_str(),
               full.triangles.size());
   std::printf("| simplifier, ratio | faces | seconds | RMS r->t (vox) | Hausdorff (vox) | normal (deg) | samples on the "
-              "wrong side | self-intersections |\n|---|---|---|---|---|---|---|---|\n");
+              "wrong side | self-intersections | the same as STL |\n|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& r : rows)
-    std::printf("| %s | %llu | %.3f | %.4f | %.3f | %.2f | %llu | %llu |\n", r.who.c_str(), (unsigned long long)r.faces,
-                r.seconds, r.rms, r.hausdorff, r.normal, (unsigned long long)r.violations,
-                (unsigned long long)r.intersections);
+    std::printf("| %s | %llu | %.3f | %.4f | %.3f | %.2f | %llu | %llu | %llu / %llu |\n", r.who.c_str(),
+                (unsigned long long)r.faces, r.seconds, r.rms, r.hausdorff, r.normal, (unsigned long long)r.violations,
+                (unsigned long long)r.intersections, (unsigned long long)r.stl_violations,
+                (unsigned long long)r.stl_intersections);
   return 0;
 }

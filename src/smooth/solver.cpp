@@ -22,7 +22,10 @@
 // the truth on a sphere, but only in 300-1,500 steps; a multigrid over the
 // same vertices with the map at 2d as the coarse level diverged; Newton on
 // the map linearized with its virtual neighbours frozen, and a two-grid
-// cycle over the volume subsampled by 2, did not lower the residual.
+// cycle over the volume subsampled by 2, did not lower the residual; an
+// energy with frozen resampling weights minimized by projected Newton
+// converged 10 % per outer step at 10-250 times the cost. On the CAD part
+// the residual left is two vertices of four-vertex curves in a 2-cycle.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
