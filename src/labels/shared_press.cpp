@@ -565,8 +565,12 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
   // The shared press's peak, measured whole-process: 0.77 GiB for 3.3 M
   // interface triangles, 2.45 GiB for 11.1 M (bench/chunk_labels.py):
   // about 240 bytes per triangle; 256 leaves room.
-  constexpr uint64_t kBytesPerTriangle = 256;
-  const uint64_t need = uint64_t(surface.mesh.triangles.size()) * kBytesPerTriangle, cap = o.extract.max_bytes;
+  // Simplifying adds about 190 bytes a triangle (the 61-label map at 1.5 mm:
+  // 692 MB peak for 1.6 M triangles with --faces): 256 more.
+  constexpr uint64_t kBytesPerTriangle = 256, kSimplifyBytesPerTriangle = 256;
+  const bool simplifying = o.simplify.faces || o.simplify.max_error > 0;
+  const uint64_t need = uint64_t(surface.mesh.triangles.size()) * (kBytesPerTriangle + (simplifying ? kSimplifyBytesPerTriangle : 0)),
+                 cap = o.extract.max_bytes;
   if (cap && need > cap)
     throw LimitError(source, "pressing the shared surface of " + std::to_string(surface.mesh.triangles.size()) +
                                  " triangles needs about " + std::to_string(need >> 20) + " MiB, above the memory limit of " +

@@ -78,14 +78,19 @@ constexpr double kMaxIterations = 1e6, kMaxRings = 12;
 // Bytes per stick of the stages after extraction, at their peak (measured:
 // docs/RELIABILITY.md, Resource limits).
 constexpr uint64_t kFeatureBytesPerStick = 420, kPressBytesPerStick = 250, kOtherBytesPerStick = 320;
+// The simplifier's share on top (positions twice, quadrics, face lists,
+// grid, heap): `press --faces 8644` of the 256^3 CAD part peaked 154 MB
+// above `press` for 216,121 sticks (713 B), rounded up.
+constexpr uint64_t kSimplifyBytesPerStick = 768;
 }  // namespace
 
 uint64_t bytes_per_stick(const SurfaceOptions& o) {
   // Peak resident bytes per stick beyond the volume and the bare surface,
   // measured with /usr/bin/time on spheres and CAD parts at 256^3 and 512^3
   // (docs/RELIABILITY.md, Resource limits), rounded up.
-  if (o.method != Method::pressing) return kOtherBytesPerStick;
-  return o.passes.on(Pass::flats) ? kFeatureBytesPerStick : kPressBytesPerStick;
+  const uint64_t simplify = o.simplify.faces || o.simplify.max_error > 0 ? kSimplifyBytesPerStick : 0;
+  if (o.method != Method::pressing) return kOtherBytesPerStick + simplify;
+  return (o.passes.on(Pass::flats) ? kFeatureBytesPerStick : kPressBytesPerStick) + simplify;
 }
 
 void validate(const SurfaceOptions& o) {

@@ -442,6 +442,9 @@ TEST(Hostile, MaxMemoryChargesWhatEachSubcommandHolds) {
       // press: 7.4 MiB charged for this sphere, 2 MiB a run short of what the
       // process holds beyond its idle size (thread stacks, the writer).
       {"--max-memory 8M press " + tmp.path("s.nrrd"), "s.nrrd", "the run 2048", "p.ply"},
+      // press --faces: the simplifier's 768 bytes a stick on top (press alone
+      // is accepted from 10M for this sphere).
+      {"--max-memory 12M press " + tmp.path("s.nrrd") + " --faces 1000", "s.nrrd", "for 16344 sticks", "pf.ply"},
       // report and render charged only the volume, not its surfaces: the
       // voxel faces, then each method's surface with the meshes kept so far.
       {"--max-memory 3M report " + tmp.path("s.nrrd"), "s.nrrd", "voxel faces (160 bytes each)", "r.html"},
