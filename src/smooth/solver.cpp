@@ -24,8 +24,9 @@
 // the map linearized with its virtual neighbours frozen, and a two-grid
 // cycle over the volume subsampled by 2, did not lower the residual; an
 // energy with frozen resampling weights minimized by projected Newton
-// converged 10 % per outer step at 10-250 times the cost. On the CAD part
-// the residual left is two vertices of four-vertex curves in a 2-cycle.
+// converged 10 % per outer step at 10-250 times the cost. The CAD part's
+// residual was a loop around one sample in a 2-cycle (curve_kernel.h: tiny
+// loops now shrink d continuously); what is left there is not yet traced.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
