@@ -87,16 +87,6 @@ bool apart(const ClashFace& a, const ClashFace& b, double d) {
   return false;
 }
 
-void sorted_neighbours(const std::vector<std::vector<uint32_t>>& vf, const std::vector<Triangle>& tri, uint32_t v,
-                       std::vector<uint32_t>& out) {
-  out.clear();
-  for (uint32_t f : vf[v])
-    for (uint32_t w : tri[f])
-      if (w != v) out.push_back(w);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-}
-
 }  // namespace
 
 bool Collapser::try_move(const Move& m) {
@@ -137,8 +127,8 @@ bool Collapser::topology_ok(uint32_t u, uint32_t v) {
   for (uint32_t f : vf[u])
     if (tri[f][0] == v || tri[f][1] == v || tri[f][2] == v) shared.push_back(f);
   if (shared.size() < 2) return false;
-  sorted_neighbours(vf, tri, u, nu);
-  sorted_neighbours(vf, tri, v, nv_);
+  neighbours(u, nu);
+  neighbours(v, nv_);
   common.clear();
   std::set_intersection(nu.begin(), nu.end(), nv_.begin(), nv_.end(), std::back_inserter(common));
   if (common.size() != shared.size() || nu.size() + nv_.size() - 2 <= 4) return false;

@@ -31,9 +31,9 @@ constexpr double kGridCell = 2;
 
 }  // namespace
 
-Quadric Quadric::plane(const Vec3& n, double c, double w) {
+ErrorQuadric ErrorQuadric::plane(const Vec3& n, double c, double w) {
   const double d = -c;
-  Quadric q;
+  ErrorQuadric q;
   const double v[4] = {n.x(), n.y(), n.z(), d};
   int k = 0;
   for (int i = 0; i < 4; ++i)
@@ -41,19 +41,19 @@ Quadric Quadric::plane(const Vec3& n, double c, double w) {
   return q;
 }
 
-Quadric& Quadric::operator+=(const Quadric& o) {
+ErrorQuadric& ErrorQuadric::operator+=(const ErrorQuadric& o) {
   for (int k = 0; k < 10; ++k) a[k] += o.a[k];
   return *this;
 }
 
-double Quadric::operator()(const Vec3& p) const {
+double ErrorQuadric::operator()(const Vec3& p) const {
   const double x = p.x(), y = p.y(), z = p.z();
   const double e = a[0] * x * x + 2 * a[1] * x * y + 2 * a[2] * x * z + 2 * a[3] * x + a[4] * y * y +
                    2 * a[5] * y * z + 2 * a[6] * y + a[7] * z * z + 2 * a[8] * z + a[9];
   return std::max(0.0, e);
 }
 
-bool Quadric::minimise(Vec3& x) const {
+bool ErrorQuadric::minimise(Vec3& x) const {
   Mat3 A;
   A << a[0], a[1], a[2], a[1], a[4], a[5], a[2], a[5], a[7];
   const Vec3 b(-a[3], -a[6], -a[8]);
@@ -140,13 +140,13 @@ void Collapser::build() {
 
   // Quadrics: each face's plane, weighted by its area; soft borders add
   // their perpendicular planes, weighted by the squared border length.
-  Q.assign(nv, Quadric{});
+  Q.assign(nv, ErrorQuadric{});
   for (uint32_t f = 0; f < nf; ++f) {
     const Triangle& t = tri[f];
     const Vec3 n = (xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]);
     const double a2 = n.norm();
     if (!(a2 > 0)) continue;
-    const Quadric q = Quadric::plane(n / a2, n.dot(xp[t[0]]) / a2, a2 / 2);
+    const ErrorQuadric q = ErrorQuadric::plane(n / a2, n.dot(xp[t[0]]) / a2, a2 / 2);
     for (uint32_t v : t) Q[v] += q;
   }
   if (!o.soft_keys.empty())
@@ -162,7 +162,7 @@ void Collapser::build() {
         Vec3 m = e.cross((xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]));
         if (!(m.norm() > 0)) continue;
         m.normalize();
-        const Quadric q = Quadric::plane(m, m.dot(xp[a]), e.squaredNorm());
+        const ErrorQuadric q = ErrorQuadric::plane(m, m.dot(xp[a]), e.squaredNorm());
         Q[a] += q;
         Q[b] += q;
       }
@@ -175,15 +175,10 @@ void Collapser::build() {
   }
   // A vertex off every feature whose faces are not one disc (as many faces
   // as neighbours) is a pinch: it stays.
-  std::vector<uint32_t> around;
   for (uint32_t v = 0; v < nv; ++v) {
     if (fdeg[v] != 0) continue;
-    around.clear();
-    for (uint32_t f : vf[v])
-      for (uint32_t w : tri[f])
-        if (w != v) around.push_back(w);
-    std::sort(around.begin(), around.end());
-    if (size_t(std::unique(around.begin(), around.end()) - around.begin()) != vf[v].size()) fdeg[v] = kPinned;
+    neighbours(v, around);
+    if (around.size() != vf[v].size()) fdeg[v] = kPinned;
   }
   rebuild_grid();
 }
@@ -216,7 +211,7 @@ bool Collapser::removable(uint32_t u, uint32_t v) const {
 }
 
 int Collapser::moves(uint32_t a, uint32_t b, Move (&out)[3]) const {
-  Quadric q = Q[a];
+  ErrorQuadric q = Q[a];
   q += Q[b];
   const double len2 = (xp[a] - xp[b]).squaredNorm();
   int n = 0;
@@ -233,14 +228,18 @@ int Collapser::moves(uint32_t a, uint32_t b, Move (&out)[3]) const {
   return n;
 }
 
-void Collapser::recount(uint32_t v) {
-  if (fdeg[v] == kPinned) return;
-  std::vector<uint32_t> around;
+void Collapser::neighbours(uint32_t v, std::vector<uint32_t>& out) const {
+  out.clear();
   for (uint32_t f : vf[v])
     for (uint32_t w : tri[f])
-      if (w != v) around.push_back(w);
-  std::sort(around.begin(), around.end());
-  around.erase(std::unique(around.begin(), around.end()), around.end());
+      if (w != v) out.push_back(w);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+void Collapser::recount(uint32_t v) {
+  if (fdeg[v] == kPinned) return;
+  neighbours(v, around);
   int n = 0;
   for (uint32_t w : around) n += feature.count(key(v, w)) != 0;
   fdeg[v] = uint8_t(std::min(254, n));
@@ -351,13 +350,8 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
       if (try_move(mv[i])) {
         apply(mv[i]);
         const uint32_t v = mv[i].v;
-        nu.clear();
-        for (uint32_t f : vf[v])
-          for (uint32_t w : tri[f])
-            if (w != v) nu.push_back(w);
-        std::sort(nu.begin(), nu.end());
-        nu.erase(std::unique(nu.begin(), nu.end()), nu.end());
-        for (uint32_t w : nu) push(v, w);
+        neighbours(v, around);
+        for (uint32_t w : around) push(v, w);
         if (2 * alive_faces < grid_faces) rebuild_grid();
         if (++since == 4096) {
           progress.add(since);

@@ -21,12 +21,13 @@
 namespace voxpress::detail {
 
 /// Symmetric 4x4 error quadric (Garland and Heckbert 1997): 10 coefficients
-/// xx xy xz xw yy yz yw zz zw ww.
-struct Quadric {
+/// xx xy xz xw yy yz yw zz zw ww. (Not smooth/quadric.h's Quadric, a height
+/// field: one name for two classes in one namespace would break the ODR.)
+struct ErrorQuadric {
   double a[10] = {};
   /// weight * (n.x - c)^2 with n unit.
-  static Quadric plane(const Vec3& n, double c, double weight);
-  Quadric& operator+=(const Quadric& o);
+  static ErrorQuadric plane(const Vec3& n, double c, double weight);
+  ErrorQuadric& operator+=(const ErrorQuadric& o);
   double operator()(const Vec3& x) const;
   /// The minimiser when the 3x3 part is well conditioned.
   bool minimise(Vec3& x) const;
@@ -60,6 +61,8 @@ class Collapser {
   bool removable(uint32_t u, uint32_t v) const;
   void apply(const Move& m);
   void recount(uint32_t v);
+  /// v's neighbours, sorted, each once.
+  void neighbours(uint32_t v, std::vector<uint32_t>& out) const;
   void rebuild_grid();
   void compact(std::vector<uint32_t>* vertex_map);
   bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
@@ -82,7 +85,7 @@ class Collapser {
   std::vector<std::vector<uint32_t>> vf;  // faces around each vertex
   std::vector<uint8_t> face_alive, vertex_alive, moved;
   std::vector<uint32_t> stamp;
-  std::vector<Quadric> Q;
+  std::vector<ErrorQuadric> Q;
   std::unordered_map<uint64_t, uint8_t> feature;  // edge key -> kSharp | kBorder
   std::vector<uint8_t> fdeg;                       // feature edges at each vertex (capped at 255)
   std::vector<std::vector<uint32_t>> attached;     // per face: removed input vertices nearest to it
@@ -92,7 +95,7 @@ class Collapser {
   Vec3 sample_lo, sample_hi;                       // the samples that exist (the lattice and its padding ring)
   uint64_t alive_faces = 0;
   // Scratch of the move being checked.
-  std::vector<uint32_t> ring, shared, nu, nv_, common;
+  std::vector<uint32_t> ring, shared, nu, nv_, common, around;
   std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face) of the accepted error check
   double move_error = 0;
 };
