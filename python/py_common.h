@@ -48,6 +48,8 @@ void cut_labels(const SharedLabels& r, const std::vector<LabelInfo>& chosen, std
 void check_shared_options(const py::kwargs& kw);
 /// labels=: None (every label) or the values.
 std::vector<double> label_values(const py::object& labels);
+/// The Mesh class (mesh_py.cpp).
+void bind_mesh(py::module_& m);
 /// chunk_plan, _press_block, _stitch, _label_block, _press_label_blocks (chunk_py.cpp).
 void bind_chunks(py::module_& m);
 /// press(..., chunk=N): press_chunked on the in-memory volume.
