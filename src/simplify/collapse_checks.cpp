@@ -89,31 +89,16 @@ bool apart(const ClashFace& a, const ClashFace& b, double d) {
 
 }  // namespace
 
-bool Collapser::try_move(const Move& m) {
-  if (!topology_ok(m.u, m.v)) {
-    ++st.refused_topology;
-    return false;
-  }
+Collapser::Verdict Collapser::check(const Move& m, Probe& p) const {
+  if (!topology_ok(m.u, m.v, p)) return Verdict::topology;
   const Vec3 qi = m.q == xp[m.v] ? xi[m.v] : o.lattice ? o.lattice->to_index(m.q) : m.q;
-  ring.clear();
-  std::set_union(vf[m.u].begin(), vf[m.u].end(), vf[m.v].begin(), vf[m.v].end(), std::back_inserter(ring));
-  if (!shape_ok(m, qi)) {
-    ++st.refused_shape;
-    return false;
-  }
-  if (!error_ok(m)) {
-    ++st.refused_error;
-    return false;
-  }
-  if (!samples_ok(m, qi)) {
-    ++st.refused_samples;
-    return false;
-  }
-  if (!clash_free(m, qi)) {
-    ++st.refused_clash;
-    return false;
-  }
-  return true;
+  p.ring.clear();
+  std::set_union(vf[m.u].begin(), vf[m.u].end(), vf[m.v].begin(), vf[m.v].end(), std::back_inserter(p.ring));
+  if (!shape_ok(m, qi, p)) return Verdict::shape;
+  if (!error_ok(m, p)) return Verdict::error;
+  if (!samples_ok(m, qi, p)) return Verdict::samples;
+  if (!clash_free(m, qi, p)) return Verdict::clash;
+  return Verdict::ok;
 }
 
 // The link condition (Dey et al.'s for 2-complexes: the links of u and v
@@ -122,17 +107,18 @@ bool Collapser::try_move(const Move& m) {
 // junction line, and no face of u spans two of them), no apex left with
 // three neighbours, no component shrunk below a tetrahedron, no two
 // feature edges merged.
-bool Collapser::topology_ok(uint32_t u, uint32_t v) {
-  shared.clear();
+bool Collapser::topology_ok(uint32_t u, uint32_t v, Probe& p) const {
+  std::vector<uint32_t>& common = p.common;
+  p.shared.clear();
   for (uint32_t f : vf[u])
-    if (tri[f][0] == v || tri[f][1] == v || tri[f][2] == v) shared.push_back(f);
-  if (shared.size() < 2) return false;
-  neighbours(u, nu);
-  neighbours(v, nv_);
+    if (tri[f][0] == v || tri[f][1] == v || tri[f][2] == v) p.shared.push_back(f);
+  if (p.shared.size() < 2) return false;
+  neighbours(u, p.nu);
+  neighbours(v, p.nv);
   common.clear();
-  std::set_intersection(nu.begin(), nu.end(), nv_.begin(), nv_.end(), std::back_inserter(common));
-  if (common.size() != shared.size() || nu.size() + nv_.size() - 2 <= 4) return false;
-  for (uint32_t f : shared) {  // the apexes are the common neighbours, once each
+  std::set_intersection(p.nu.begin(), p.nu.end(), p.nv.begin(), p.nv.end(), std::back_inserter(common));
+  if (common.size() != p.shared.size() || p.nu.size() + p.nv.size() - 2 <= 4) return false;
+  for (uint32_t f : p.shared) {  // the apexes are the common neighbours, once each
     const Triangle& t = tri[f];
     const uint32_t apex = t[0] != u && t[0] != v ? t[0] : t[1] != u && t[1] != v ? t[1] : t[2];
     if (!std::binary_search(common.begin(), common.end(), apex)) return false;
@@ -143,7 +129,7 @@ bool Collapser::topology_ok(uint32_t u, uint32_t v) {
     if (fu && fv) return false;
   }
   for (uint32_t f : vf[u]) {
-    if (is_shared(f)) continue;
+    if (p.is_shared(f)) continue;
     int in_common = 0;
     for (uint32_t w : tri[f]) in_common += w != u && std::binary_search(common.begin(), common.end(), w);
     if (in_common == 2) return false;
@@ -151,9 +137,9 @@ bool Collapser::topology_ok(uint32_t u, uint32_t v) {
   return true;
 }
 
-bool Collapser::shape_ok(const Move& m, const Vec3& qi) {
-  for (uint32_t f : ring) {
-    if (is_shared(f)) continue;
+bool Collapser::shape_ok(const Move& m, const Vec3& qi, const Probe& p) const {
+  for (uint32_t f : p.ring) {
+    if (p.is_shared(f)) continue;
     const Triangle& t = tri[f];
     const Vec3 n0 = (xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]);
     const Vec3 a = at_phys(t[0], m), b = at_phys(t[1], m), c = at_phys(t[2], m);
@@ -167,14 +153,14 @@ bool Collapser::shape_ok(const Move& m, const Vec3& qi) {
 // Every input vertex gone from the patch (attached to its faces, or u, or
 // v leaving its input position) goes to its nearest new face; the move's
 // error is the largest of those distances and of q's to the old patch.
-bool Collapser::error_ok(const Move& m) {
-  assign.clear();
-  move_error = 0;
+bool Collapser::error_ok(const Move& m, Probe& pr) const {
+  pr.assign.clear();
   if (!(o.max_error > 0)) return true;  // no bound: the error is measured once, at the end
+  double move_error = 0;
   auto nearest = [&](const Vec3& p, uint32_t& best) {
     double d2 = INFINITY;
-    for (uint32_t f : ring) {
-      if (is_shared(f)) continue;
+    for (uint32_t f : pr.ring) {
+      if (pr.is_shared(f)) continue;
       const Triangle& t = tri[f];
       const double e = point_triangle_distance2(p, at_phys(t[0], m), at_phys(t[1], m), at_phys(t[2], m));
       if (e < d2) {
@@ -187,34 +173,34 @@ bool Collapser::error_ok(const Move& m) {
   auto place = [&](uint32_t p) {
     uint32_t f = 0;
     move_error = std::max(move_error, std::sqrt(nearest(input[p], f)));
-    assign.emplace_back(p, f);
+    pr.assign.emplace_back(p, f);
   };
-  for (uint32_t f : ring)
+  for (uint32_t f : pr.ring)
     for (uint32_t p : attached[f]) place(p);
   if (!moved[m.u]) place(m.u);
   if (!moved[m.v] && m.q != xp[m.v]) place(m.v);
   if (m.q != xp[m.v] && m.q != xp[m.u]) {
     double d2 = INFINITY;
-    for (uint32_t f : ring) {
+    for (uint32_t f : pr.ring) {
       const Triangle& t = tri[f];
       d2 = std::min(d2, point_triangle_distance2(m.q, xp[t[0]], xp[t[1]], xp[t[2]]));
     }
     move_error = std::max(move_error, std::sqrt(d2));
   }
-  return !(o.max_error > 0) || move_error <= o.max_error;
+  return move_error <= o.max_error;
 }
 
 // No sample swept on the way (u to q, then v to q) nor within the
 // clearance of a final face. Only samples that exist are checked: the
 // lattice and its ring of virtual outside samples.
-bool Collapser::samples_ok(const Move& m, const Vec3& qi) const {
+bool Collapser::samples_ok(const Move& m, const Vec3& qi, const Probe& p) const {
   if (!o.lattice) return true;
   const double d2 = delta * delta;
   auto any = [&](std::initializer_list<Vec3> pts, auto&& hit) {
     Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-    for (const Vec3& p : pts) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
+    for (const Vec3& x : pts) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
     }
     lo = (lo.array() - delta).ceil().max(sample_lo.array());
     hi = (hi.array() + delta).floor().min(sample_hi.array());
@@ -239,8 +225,8 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi) const {
       if (any({a, qi, c, d}, [&](const Vec3& z) { return swept(a, qi, c, d, z, d2); })) return false;
     }
   }
-  for (uint32_t f : ring) {
-    if (is_shared(f)) continue;
+  for (uint32_t f : p.ring) {
+    if (p.is_shared(f)) continue;
     const Triangle& t = tri[f];
     const Vec3 a = at_index(t[0], m, qi), b = at_index(t[1], m, qi), c = at_index(t[2], m, qi);
     const Vec3 n = (b - a).cross(c - a).normalized();  // shape_ok: not degenerate
@@ -255,12 +241,15 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi) const {
 
 // The new faces neither meet nor come within the clearance of each other or
 // of any other face.
-bool Collapser::clash_free(const Move& m, const Vec3& qi) const {
+bool Collapser::clash_free(const Move& m, const Vec3& qi, Probe& p) const {
   ClashFace nf[64];
   int n = 0;
-  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-  for (uint32_t f : ring) {
-    if (is_shared(f)) continue;
+  Vec3& lo = p.lo;
+  Vec3& hi = p.hi;
+  lo = Vec3::Constant(INFINITY);
+  hi = Vec3::Constant(-INFINITY);
+  for (uint32_t f : p.ring) {
+    if (p.is_shared(f)) continue;
     if (n == 64) return false;  // a vertex of over 60 faces: not worth the check
     ClashFace& g = nf[n++];
     for (int c = 0; c < 3; ++c) {
@@ -288,7 +277,7 @@ bool Collapser::clash_free(const Move& m, const Vec3& qi) const {
       if (overlap(nf[i], nf[j].lo, nf[j].hi) && clash(nf[i], nf[j])) return false;
   bool clashed = false;
   grid.query(lo, hi, [&](uint32_t g) {
-    if (clashed || std::binary_search(ring.begin(), ring.end(), g)) return;
+    if (clashed || std::binary_search(p.ring.begin(), p.ring.end(), g)) return;
     const Triangle& t = tri[g];
     ClashFace c;
     for (int k = 0; k < 3; ++k) {

@@ -4,6 +4,7 @@
 #include "simplify/collapser.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Dense>
@@ -28,6 +29,11 @@ constexpr double kOptimumReach = 2;
 // The face grid's cell in mean face extents: fewer, fuller cells (the
 // query is bound by cache misses per cell; build/bench/bench_simplify).
 constexpr double kGridCell = 2;
+// A round checks at most kRound moves in parallel, looking at most kLook
+// times as many heap entries for them: rounds of a few hundred keep the
+// cost order nearly serial and the threads busy (build/bench/bench_simplify).
+constexpr uint64_t kRound = 256;
+constexpr size_t kLook = 4;
 
 }  // namespace
 
@@ -251,9 +257,9 @@ void Collapser::box_of(uint32_t f, Vec3& lo, Vec3& hi) const {
   hi = xi[t[0]].cwiseMax(xi[t[1]]).cwiseMax(xi[t[2]]);
 }
 
-void Collapser::apply(const Move& m) {
+void Collapser::apply(const Move& m, const Probe& p) {
   const uint32_t u = m.u, v = m.v;
-  for (uint32_t f : shared) {
+  for (uint32_t f : p.shared) {
     face_alive[f] = 0;
     grid.erase(f);
     attached[f].clear();
@@ -275,10 +281,10 @@ void Collapser::apply(const Move& m) {
   vf[v] = std::move(keep);
   vf[u].clear();
   vertex_alive[u] = 0;
-  alive_faces -= shared.size();
+  alive_faces -= p.shared.size();
   // Feature edges of u become v's (flags joined); u-v itself disappears.
   std::vector<std::pair<uint32_t, uint8_t>> carried;
-  for (uint32_t w : nu) {
+  for (uint32_t w : p.nu) {
     const auto it = feature.find(key(u, w));
     if (it == feature.end()) continue;
     if (w != v) carried.emplace_back(w, it->second);
@@ -296,7 +302,7 @@ void Collapser::apply(const Move& m) {
   ++stamp[u];
   ++stamp[v];
   for (uint32_t f : vf[v]) attached[f].clear();  // re-assigned below, from the checked assignment
-  for (const auto& [p, f] : assign) attached[f].push_back(p);
+  for (const auto& [x, f] : p.assign) attached[f].push_back(x);
   // The faces whose corners moved: u's, and v's too when v moved.
   for (uint32_t f : v_moved ? vf[v] : from_u) {
     Vec3 lo, hi;
@@ -309,6 +315,54 @@ void Collapser::apply(const Move& m) {
     for (const auto& [w, flags] : carried) recount(w);
   }
   ++st.collapses;
+}
+
+// Takes the round's moves off the heap, cheapest first: at most `want`
+// (kRound) edges whose closed neighbourhoods (both ends and their
+// neighbours) meet no earlier one's; an edge that meets one goes back on
+// the heap for a later round, a stale one (an end removed or changed since
+// it was pushed) is dropped. Returns how many were taken.
+size_t Collapser::select(std::priority_queue<Entry>& heap, uint64_t want) {
+  want = std::clamp<uint64_t>(want, 1, kRound);
+  ++round_id_;
+  if (round_.size() < want) round_.resize(want);
+  std::vector<Entry> later;
+  size_t n = 0;
+  for (size_t looked = 0; n < want && looked < kLook * want && !heap.empty();) {
+    const Entry e = heap.top();
+    heap.pop();
+    if (!vertex_alive[e.a] || !vertex_alive[e.b] || stamp[e.a] != e.sa || stamp[e.b] != e.sb) continue;
+    ++looked;
+    if (claim_[e.a] == round_id_ || claim_[e.b] == round_id_) {
+      later.push_back(e);
+      continue;
+    }
+    neighbours(e.a, around);
+    neighbours(e.b, ring_b);
+    const auto taken = [&](uint32_t w) { return claim_[w] == round_id_; };
+    if (std::any_of(around.begin(), around.end(), taken) || std::any_of(ring_b.begin(), ring_b.end(), taken)) {
+      later.push_back(e);
+      continue;
+    }
+    for (uint32_t w : around) claim_[w] = round_id_;
+    for (uint32_t w : ring_b) claim_[w] = round_id_;
+    Candidate& c = round_[n++];
+    c.entry = e;
+    c.n = moves(e.a, e.b, c.mv);
+  }
+  for (const Entry& e : later) heap.push(e);
+  return n;
+}
+
+void Collapser::count(Verdict v) {
+  switch (v) {
+    case Verdict::ok: break;
+    case Verdict::topology: ++st.refused_topology; break;
+    case Verdict::shape: ++st.refused_shape; break;
+    case Verdict::error: ++st.refused_error; break;
+    case Verdict::samples: ++st.refused_samples; break;
+    case Verdict::clash: ++st.refused_clash; break;
+  }
 }
 
 SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
@@ -325,40 +379,92 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     return st;
   }
   build();
-  std::priority_queue<Entry> heap;
-  const auto push = [&](uint32_t a, uint32_t b) {
-    Move mv[3];
-    const int n = moves(a, b, mv);
-    if (n == 0) return;
-    heap.push({mv[0].cost, mv[0].len2, std::min(a, b), std::max(a, b), stamp[std::min(a, b)], stamp[std::max(a, b)]});
-  };
-  for (uint32_t f = 0; f < tri.size(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      const uint32_t a = tri[f][size_t(c)], b = tri[f][size_t((c + 1) % 3)];
-      if (a < b) push(a, b);
-    }
+  // Every edge's cheapest move, costed in parallel, in face order.
+  std::vector<Entry> first(3 * tri.size());
+  std::vector<uint8_t> has(first.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tri.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f < r.end(); ++f)
+      for (size_t c = 0; c < 3; ++c) {
+        const uint32_t a = tri[f][c], b = tri[f][(c + 1) % 3];
+        Move mv[3];
+        if (a > b || moves(a, b, mv) == 0) continue;
+        first[3 * f + c] = {mv[0].cost, mv[0].len2, a, b, stamp[a], stamp[b]};
+        has[3 * f + c] = 1;
+      }
+  });
+  size_t edges = 0;
+  for (size_t i = 0; i < first.size(); ++i)
+    if (has[i]) first[edges++] = first[i];
+  first.resize(edges);
+  has = {};
+  std::priority_queue<Entry> heap(std::less<Entry>(), std::move(first));
   const uint64_t target = o.faces;
   ProgressCounter progress(o.progress, "simplify", target < st.faces_before ? (st.faces_before - target) / 2 : 0);
-  uint64_t since = 0;
+  claim_.assign(xp.size(), 0);
+  // Rounds: the cheapest edges whose neighbourhoods do not touch are
+  // checked in parallel against the state before the round, then applied
+  // in cost order. Two such moves change disjoint faces and vertices, so
+  // each one's checks still hold after the others, except that their new
+  // faces could come near each other: a move whose new faces' box meets
+  // one applied earlier in the round is checked again first. The rounds
+  // depend on the costs only, so the result is the same for any number of
+  // threads.
+  std::vector<std::pair<Vec3, Vec3>> applied;
+  std::vector<uint32_t> kept;
+  std::vector<std::vector<Entry>> fresh;
   while (alive_faces > target && !heap.empty()) {
-    const Entry e = heap.top();
-    heap.pop();
-    if (!vertex_alive[e.a] || !vertex_alive[e.b] || stamp[e.a] != e.sa || stamp[e.b] != e.sb) continue;
-    Move mv[3];
-    const int n = moves(e.a, e.b, mv);
-    for (int i = 0; i < n; ++i)
-      if (try_move(mv[i])) {
-        apply(mv[i]);
-        const uint32_t v = mv[i].v;
-        neighbours(v, around);
-        for (uint32_t w : around) push(v, w);
-        if (2 * alive_faces < grid_faces) rebuild_grid();
-        if (++since == 4096) {
-          progress.add(since);
-          since = 0;
-        }
-        break;
+    const size_t n = select(heap, (alive_faces - target + 1) / 2);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        Candidate& c = round_[i];
+        c.accepted = -1;
+        for (int k = 0; k < c.n && c.accepted < 0; ++k)
+          if ((c.verdict[k] = check(c.mv[k], c.probe)) == Verdict::ok) c.accepted = k;
       }
+    });
+    applied.clear();
+    for (size_t i = 0; i < n && alive_faces > target; ++i) {
+      Candidate& c = round_[i];
+      for (int k = 0; k < c.n && k <= c.accepted; ++k) count(c.verdict[k]);
+      if (c.accepted < 0) continue;
+      const Move& m = c.mv[c.accepted];
+      const auto meets = [&](const std::pair<Vec3, Vec3>& b) {
+        return !((c.probe.lo.array() > b.second.array()).any() || (b.first.array() > c.probe.hi.array()).any());
+      };
+      if (std::any_of(applied.begin(), applied.end(), meets)) {
+        const Verdict again = check(m, c.probe);
+        if (again != Verdict::ok) {
+          count(again);
+          continue;
+        }
+      }
+      apply(m, c.probe);
+      applied.emplace_back(c.probe.lo, c.probe.hi);
+      kept.push_back(m.v);
+    }
+    // The kept vertices' edges, costed in parallel (a kept vertex's
+    // neighbours are in its own move's neighbourhood, which no other move
+    // of the round touched) and pushed in order.
+    fresh.resize(kept.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, kept.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
+      std::vector<uint32_t> nb;
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        const uint32_t v = kept[i];
+        fresh[i].clear();
+        neighbours(v, nb);
+        for (uint32_t w : nb) {
+          Move mv[3];
+          if (moves(v, w, mv) == 0) continue;
+          const uint32_t a = std::min(v, w), b = std::max(v, w);
+          fresh[i].push_back({mv[0].cost, mv[0].len2, a, b, stamp[a], stamp[b]});
+        }
+      }
+    });
+    for (const auto& entries : fresh)
+      for (const Entry& e : entries) heap.push(e);
+    progress.add(kept.size());
+    kept.clear();
+    if (2 * alive_faces < grid_faces) rebuild_grid();
   }
   compact(vertex_map);
   // The error: the farthest input vertex from the result (order-free max).

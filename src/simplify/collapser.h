@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <queue>
 #include <unordered_map>
 #include <vector>
 
@@ -54,25 +55,48 @@ class Collapser {
   static constexpr uint8_t kPinned = 255;      // fdeg of a vertex that never moves (a pinch)
   static uint64_t key(uint32_t a, uint32_t b) { return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a; }
 
+  /// What checking one move finds and needs (one per move in a round, so
+  /// that the moves of a round are checked in parallel): the faces around
+  /// u or v (`ring`, sorted), those on the edge (`shared`), u's neighbours,
+  /// the removed input vertices' new faces, and the box of the new faces
+  /// grown by the clearance (index space).
+  struct Probe {
+    std::vector<uint32_t> ring, shared, nu, nv, common;
+    std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face)
+    Vec3 lo, hi;
+    bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
+  };
+  enum class Verdict : uint8_t { ok, topology, shape, error, samples, clash };
+  /// An edge of the heap taken into a round: its moves, cheapest first, and
+  /// the first that passed its checks (-1: none).
+  struct Candidate {
+    Entry entry;
+    Move mv[3];
+    Verdict verdict[3];
+    int n = 0, accepted = -1;
+    Probe probe;
+  };
+
   // collapser.cpp
   void build();
-  void push(uint32_t a, uint32_t b);
   int moves(uint32_t a, uint32_t b, Move (&out)[3]) const;
   bool removable(uint32_t u, uint32_t v) const;
-  void apply(const Move& m);
+  size_t select(std::priority_queue<Entry>& heap, uint64_t want);
+  void apply(const Move& m, const Probe& p);
   void recount(uint32_t v);
+  void count(Verdict v);
   /// v's neighbours, sorted, each once.
   void neighbours(uint32_t v, std::vector<uint32_t>& out) const;
   void rebuild_grid();
   void compact(std::vector<uint32_t>* vertex_map);
-  bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
-  // collapse_checks.cpp
-  bool try_move(const Move& m);
-  bool topology_ok(uint32_t u, uint32_t v);
-  bool shape_ok(const Move& m, const Vec3& qi);
-  bool error_ok(const Move& m);
-  bool samples_ok(const Move& m, const Vec3& qi) const;
-  bool clash_free(const Move& m, const Vec3& qi) const;
+  // collapse_checks.cpp: pure functions of the state (a round's moves are
+  // checked in parallel against the state before the round).
+  Verdict check(const Move& m, Probe& p) const;
+  bool topology_ok(uint32_t u, uint32_t v, Probe& p) const;
+  bool shape_ok(const Move& m, const Vec3& qi, const Probe& p) const;
+  bool error_ok(const Move& m, Probe& p) const;
+  bool samples_ok(const Move& m, const Vec3& qi, const Probe& p) const;
+  bool clash_free(const Move& m, const Vec3& qi, Probe& p) const;
   void box_of(uint32_t f, Vec3& lo, Vec3& hi) const;
   Vec3 at_index(uint32_t w, const Move& m, const Vec3& qi) const { return w == m.u || w == m.v ? qi : xi[w]; }
   Vec3 at_phys(uint32_t w, const Move& m) const { return w == m.u || w == m.v ? m.q : xp[w]; }
@@ -89,15 +113,15 @@ class Collapser {
   std::unordered_map<uint64_t, uint8_t> feature;  // edge key -> kSharp | kBorder
   std::vector<uint8_t> fdeg;                       // feature edges at each vertex (capped at 255)
   std::vector<std::vector<uint32_t>> attached;     // per face: removed input vertices nearest to it
-  mutable FaceGrid grid;  // its query marks the faces it reports
+  FaceGrid grid;
   uint64_t grid_faces = 0;  // alive faces when the grid was last built
   double delta = 0;                                // index-space clearance
   Vec3 sample_lo, sample_hi;                       // the samples that exist (the lattice and its padding ring)
   uint64_t alive_faces = 0;
-  // Scratch of the move being checked.
-  std::vector<uint32_t> ring, shared, nu, nv_, common, around;
-  std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face) of the accepted error check
-  double move_error = 0;
+  std::vector<Candidate> round_;      // the moves of the current round
+  std::vector<uint32_t> claim_;       // per vertex: the last round whose footprint holds it
+  uint32_t round_id_ = 0;
+  std::vector<uint32_t> around, ring_b;  // scratch of the serial steps
 };
 
 }  // namespace voxpress::detail

@@ -29,8 +29,6 @@ class FaceGrid {
     slot_.assign(1024, 0);
     lists_.clear();
     range_.assign(faces, {});
-    mark_.assign(faces, 0);
-    epoch_ = 0;
   }
   double side() const { return side_; }
 
@@ -41,13 +39,13 @@ class FaceGrid {
       r.hi[k] = cell(hi[k]);
     }
     r.used = true;
-    visit_cells(r, [&](uint64_t key) { lists_[find_or_add(key)].push_back(f); });
+    visit_cells(r, [&](const std::array<int32_t, 3>&, uint64_t key) { lists_[find_or_add(key)].push_back(f); });
   }
 
   void erase(uint32_t f) {
     Range& r = range_[f];
     if (!r.used) return;
-    visit_cells(r, [&](uint64_t key) {
+    visit_cells(r, [&](const std::array<int32_t, 3>&, uint64_t key) {
       std::vector<uint32_t>& v = lists_[find(key)];
       *std::find(v.begin(), v.end(), f) = v.back();
       v.pop_back();
@@ -68,26 +66,26 @@ class FaceGrid {
     insert(f, lo, hi);
   }
 
-  /// visit(f) once for every triangle listed in a cell [lo, hi] meets.
+  /// visit(f) once for every triangle listed in a cell [lo, hi] meets. A
+  /// triangle is reported from the first cell (lowest x, y, z) where its
+  /// cells and the query's meet, so the query writes nothing: queries may
+  /// run in parallel.
   template <class F>
-  void query(const Vec3& lo, const Vec3& hi, F&& visit) {
-    if (++epoch_ == 0) {  // wrapped: clear the marks
-      std::fill(mark_.begin(), mark_.end(), 0);
-      epoch_ = 1;
-    }
+  void query(const Vec3& lo, const Vec3& hi, F&& visit) const {
     Range r;
     for (int k = 0; k < 3; ++k) {
       r.lo[k] = cell(lo[k]);
       r.hi[k] = cell(hi[k]);
     }
-    visit_cells(r, [&](uint64_t key) {
+    visit_cells(r, [&](const std::array<int32_t, 3>& c, uint64_t key) {
       const uint32_t i = find(key);
       if (i == kNone) return;
-      for (uint32_t f : lists_[i])
-        if (mark_[f] != epoch_) {
-          mark_[f] = epoch_;
+      for (uint32_t f : lists_[i]) {
+        const Range& fr = range_[f];
+        if (c[0] == std::max(r.lo[0], fr.lo[0]) && c[1] == std::max(r.lo[1], fr.lo[1]) &&
+            c[2] == std::max(r.lo[2], fr.lo[2]))
           visit(f);
-        }
+      }
     });
   }
 
@@ -135,10 +133,12 @@ class FaceGrid {
   template <class F>
   static void visit_cells(const Range& r, F&& f) {
     const uint64_t m = (uint64_t(1) << 21) - 1;
-    for (int64_t z = r.lo[2]; z <= r.hi[2]; ++z)
-      for (int64_t y = r.lo[1]; y <= r.hi[1]; ++y)
-        for (int64_t x = r.lo[0]; x <= r.hi[0]; ++x)
-          f(((uint64_t(x + kBias) & m) << 42) | ((uint64_t(y + kBias) & m) << 21) | (uint64_t(z + kBias) & m));
+    for (int32_t z = r.lo[2]; z <= r.hi[2]; ++z)
+      for (int32_t y = r.lo[1]; y <= r.hi[1]; ++y)
+        for (int32_t x = r.lo[0]; x <= r.hi[0]; ++x)
+          f(std::array<int32_t, 3>{x, y, z}, ((uint64_t(int64_t(x) + kBias) & m) << 42) |
+                                                 ((uint64_t(int64_t(y) + kBias) & m) << 21) |
+                                                 (uint64_t(int64_t(z) + kBias) & m));
   }
 
   double side_ = 1;
@@ -146,8 +146,6 @@ class FaceGrid {
   std::vector<uint32_t> slot_;
   std::vector<std::vector<uint32_t>> lists_;
   std::vector<Range> range_;
-  std::vector<uint32_t> mark_;
-  uint32_t epoch_ = 0;
 };
 
 }  // namespace voxpress::detail

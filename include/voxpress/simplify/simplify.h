@@ -11,9 +11,9 @@
 // them only and their corners never move; every other vertex is the
 // quadric's minimiser or an input vertex. A flat therefore ends as large
 // triangles inside its borders (a few dozen on a 256^3 part at 2 %: its
-// vertices, clamped to their sticks, are not all on its plane). Serial and
-// ordered by (cost, edge), so the result is the same bytes for any thread
-// count.
+// vertices, clamped to their sticks, are not all on its plane). Collapses
+// run in rounds of non-touching edges, cheapest first, checked in parallel
+// and applied in (cost, edge) order: the same bytes for any thread count.
 #pragma once
 
 #include <cstdint>
