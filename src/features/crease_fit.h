@@ -52,7 +52,8 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
 // `sharp_angle` (a fillet split in two), a new point farther than
 // `other_distance` cells from the other side's quadric (no crease within
 // reach) or a move longer than `max_move` along its stick rejects the
-// vertex. Measured choices: docs/ARCHITECTURE.md at d97b886 (Curved creases).
+// vertex. Measured on fandisk by the `curved-creases` row of
+// `build/bench/bench_ablation --cases fandisk.off` (docs/BENCHMARKS.md, Ablation).
 struct CurvedCreaseFit {
   double band_angle = 15;  // degrees (physical)
   uint32_t rings = 6;

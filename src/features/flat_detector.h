@@ -163,10 +163,12 @@ struct Detector {
   // and the CAD part at 64-256 0.55-1.09, one piece of a box 64 face 1.21;
   // the CAD part's corner strips at 256^3 1.77-1.81; fandisk's flats at
   // 256^3 a continuum up to 2.24, those on its gently curved faces from
-  // ~1.3. The default gain (FlatOptions::curved_gain) is 1.3: fandisk 256
-  // seeds 1-3 drop from 27-36 flats to 13-14 and result->truth from
-  // 0.060-0.064 to 0.055-0.057; the generated shapes are unchanged (1.2
-  // would refuse the box piece: docs/ARCHITECTURE.md at d97b886, Flats: Curvature test).
+  // ~1.3. The default gain (FlatOptions::curved_gain) is 1.3: it refuses
+  // most flats on fandisk's gently curved faces at 256^3, which lowers its
+  // error, and leaves the generated shapes unchanged, where 1.2 would refuse
+  // the box piece (measured by `build/bench/bench_flats --model
+  // ../shared/data/meshes/fandisk.off --res 256 --seeds 3` and
+  // `build/bench/bench_flats`; docs/BENCHMARKS.md, Flats and junctions).
   bool curved(const std::vector<uint32_t>& core, const Plane& P) {
     std::vector<uint32_t> ext;
     neighbourhood(core, P, kCurvedRings, kCurvedWindow, ext);

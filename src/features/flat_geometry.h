@@ -30,8 +30,9 @@ constexpr int kNormalRings = 3;  // smoothing rounds of the estimated normals
 // The growth also takes a stick the current plane misses by up to this
 // fraction of it (the refit must then stab it, or it leaves): the sticks a
 // plane a hair off misses come in lattice rows that would cut a face in
-// bands. Box 64, seeds 1-30: 28 -> 29 with six flats, stick error 0.074 ->
-// 0.065; 0.1 and 0.2 found fewer faces on the CAD part at 64^3.
+// bands (measured by `build/bench/bench_flats --shape box --res 64 --seeds
+// 30`: more boxes with exactly six flats, a lower stick error); 0.1 and 0.2
+// found fewer faces on the CAD part at 64^3 (`--shape cad-part --res 64`).
 constexpr double kGrowSlack = 0.05;
 constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 // An accumulator cell seeds a cluster when it has at least this share of
@@ -40,8 +41,8 @@ constexpr int kExtendRounds = 4;  // rounds of flat extension up to sharp edges
 // cone of the cell's direction, so a face whose estimate its rounded edges
 // bend has far fewer voters than sticks: a face of several hundred cells
 // between rounded edges can have only a few dozen in its best cell, and a
-// share of 1 never tries it (docs/ARCHITECTURE.md at d97b886, Flats:
-// Greedy extraction).
+// share of 1 never tries it (measured by `build/bench/bench_flats`'s fandisk
+// rows and `--shape cad-part --res 64 --seeds 60`: more faces found).
 constexpr double kSeedShare = 0.3;
 // The curvature test (Detector::curved, FlatOptions::curved_gain): a flat's
 // neighbourhood is its core grown kCurvedRings rings over the vertices whose
@@ -65,8 +66,8 @@ constexpr double kThinRow = 0.15;
 // within kRestabRange degrees (kRestabSteps coarse steps each way, then two
 // 5 x 5 grids 4 and 16 times finer), with at most kRestabSample sticks;
 // taken when it stabs kRestabGain x as many; at most kRestabRounds rounds.
-// Measured on boxes, cylinders, tori, the CAD part and fandisk
-// (docs/ARCHITECTURE.md at d97b886, Flats: Stabbing refit).
+// Measured on boxes, cylinders, tori, the CAD part and fandisk by
+// `build/bench/bench_flats` (docs/BENCHMARKS.md, Flats and junctions).
 constexpr int kRestabRings = 10;
 constexpr double kRestabWindow = 15;
 constexpr double kRestabTrigger = 0.9;

@@ -221,10 +221,11 @@ struct Sharpener {
   // neither side is a junction and the crease had no chamfer edge at all),
   // and of a face crossed by a lattice row nearly in its plane. A real
   // curved face is deeper than that a few rings in, so only its ragged
-  // border's pockets could qualify (docs/ARCHITECTURE.md at d97b886: 2 rings measured
-  // best). Strip vertices join a flat's label but are not projected onto
-  // its plane: on the fandisk, whose flats include gently curved faces, the
-  // projection cost more accuracy than it gained.
+  // border's pockets could qualify (2 rings measured best; the pass's effect:
+  // the `strips` row of build/bench/bench_ablation). Strip vertices join a
+  // flat's label but are not projected onto its plane: on the fandisk, whose
+  // flats include gently curved faces, the projection cost more accuracy
+  // than it gained.
   // A thin vertex with a curved vertex within `strip_rings` rings that is
   // not thin itself is in a pocket of a flat's ragged rim next to a real
   // curved face (kRimStrip), not in a strip between flats: join_leftovers
@@ -389,7 +390,8 @@ struct Sharpener {
   // the wall's, so the chamfers on both sides cut along wall ∩ A and wall ∩
   // B. Fixed 2- or 3-ring fits were measured worse than 1 ring (their
   // infeasible fits left vertices out); 3 rings first, then 2 and 1, is no
-  // better than 2 then 1 (docs/ARCHITECTURE.md at d97b886). Rim vertices on a flat's
+  // better than 2 then 1 (measured with `build/bench/bench_ablation --cases
+  // plate_holes.STL,thingi10k-65004.stl --passes walls`). Rim vertices on a flat's
   // stick (its outside sample above a face) that joined a flat, and the
   // flats' own vertices next to the wall, go where their stick first leaves
   // the solid, through the wall or the flat; left on a flat mid-rim, they

@@ -19,7 +19,8 @@ namespace voxpress::detail {
 // PressOptions::free_ends: pieces from barrier to barrier of at least this
 // many segments (7 vertices between the barriers) get free ends. Measured
 // 4 / 6 / 8 / 12: 8 keeps most of fandisk's gain without costing the small
-// holes of plate_holes at 128^3 (docs/ARCHITECTURE.md at d97b886).
+// holes of plate_holes at 128^3 (their rows of `build/bench/bench_compare
+// --quick --only pressing`).
 inline constexpr uint32_t kFreePiece = 8;
 
 // A location on a polyline: point k + f (point k + 1 - point k); past a

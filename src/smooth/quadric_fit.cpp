@@ -21,8 +21,8 @@ namespace {
 // Quadric::stab's weight. The curved creases use 100; here each vertex has
 // its own fit, and at 100 the active sets' jumps between neighbouring fits
 // roughen the surface (sphere 128 normal error 0.47 -> 0.75 degrees); 10
-// keeps most of the gain (fandisk 128 seeds 1-4 r->t 0.0590 -> 0.0556,
-// normal error 2.69 -> 2.68 degrees; sphere 0.0328 -> 0.0317, 0.57 degrees).
+// keeps most of the gain on fandisk and the sphere (measured by
+// `bench/press_eval fandisk.off 128 N` and `bench/press_eval sphere 128 1`).
 constexpr double kStabWeight = 10;
 
 // A trusted fit, stored compactly (u and w follow from n).

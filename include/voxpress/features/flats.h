@@ -36,8 +36,7 @@
 //     method). When no plane stabs them all, the members the current plane
 //     misses leave the cluster and the plane moves from the current one
 //     towards the least-squares one as far as feasibility allows (an exact
-//     line search: the constraints are linear in (n, c))
-//     (docs/ARCHITECTURE.md at d97b886).
+//     line search: the constraints are linear in (n, c)).
 //  5. Rim. The flat finally takes the stabbed sticks within `rim_rings`
 //     surface edges of its core, so it reaches its edges, where the estimate
 //     was rounded. Beyond the paper, once the junctions are known, the rim
@@ -66,8 +65,9 @@
 // border (a fillet), not a junction. Frozen vertices next to a junction along a slice
 // curve become barriers: the smoothing cuts the curves there, so no virtual
 // neighbour is taken across the sharp feature (the open pieces keep a
-// clamped bilaplacian; the paper's Fig. 7 alignment was tried and dropped,
-// docs/ARCHITECTURE.md at d97b886). Instead, beyond the paper, fit_creases places the
+// clamped bilaplacian; the paper's Fig. 7 alignment was tried and dropped:
+// it never converged, docs/BENCHMARKS.md, Flats and junctions). Instead,
+// beyond the paper, fit_creases places the
 // fresh vertices near a junction from a quadric fitted to the curved side
 // farther away, extrapolated up to the flat, and fit_curved_creases places
 // the creases between two curved faces from quadrics fitted on both sides,

@@ -92,7 +92,9 @@ struct PressOptions {
   /// Pieces with fewer than 7 vertices between their barriers (a thin
   /// wall's rim, a small hole) keep the barriers as fixed ends, as do all
   /// pieces when false. press_with_flats turns it off for its estimates
-  /// (measured: docs/ARCHITECTURE.md at d97b886, Flats, Fig. 7 — free ends).
+  /// (with free ends the estimates find other flats and the CAD part's sharp
+  /// edges get worse: `bench/press_eval cad-part 128 N`; the gain of free ends
+  /// in the final press: the `free-ends` row of build/bench/bench_ablation).
   bool free_ends = true;
   /// Beyond the paper: the circle correction, in degrees (0: the paper's
   /// bilaplacian). The bilaplacian is not zero on a circle: it moves a
@@ -103,7 +105,8 @@ struct PressOptions {
   /// cos(theta), theta the angle between its chords to its two virtual
   /// neighbours (at most this cap), which makes circles of radius above
   /// d / sin(cap) fixed points and leaves straight stretches to the paper's
-  /// iteration. Measured: docs/ARCHITECTURE.md at d97b886, Pressing: circle correction.
+  /// iteration. Measured: docs/BENCHMARKS.md, Pressing, Iterations
+  /// (`bench/press_eval sphere 128 1 --circle-correction DEG`).
   /// Values outside [0, 90] are clamped to it. The CLI accepts [0, 45]: at
   /// staircase and crease corners the chords turn 45 degrees or more, and
   /// only the uncorrected operator removes those.
@@ -151,7 +154,8 @@ int press_levels_for_extent(int requested, int64_t extent);
 /// kept in [margin, 1 - margin] (so, as in pressing, no sample changes
 /// side). All vertices are fitted from the pressed positions
 /// (Jacobi: the result does not depend on the order or the thread count).
-/// Measured choices: docs/ARCHITECTURE.md at d97b886 (Pressing, local quadric fit).
+/// Measured: the `quadric-fit` row of build/bench/bench_ablation
+/// (docs/BENCHMARKS.md, Ablation).
 struct QuadricFitOptions {
   int rings = 5;            ///< the fit's neighbourhood (0: no fit)
   double residual = 0.08;   ///< cells: largest RMS residual of a trusted fit
