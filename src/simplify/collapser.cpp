@@ -425,7 +425,8 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     applied.clear();
     for (size_t i = 0; i < n && alive_faces > target; ++i) {
       Candidate& c = round_[i];
-      for (int k = 0; k < c.n && k <= c.accepted; ++k) count(c.verdict[k]);
+      const int tried = c.accepted < 0 ? c.n : c.accepted + 1;  // the refused moves, then the kept one
+      for (int k = 0; k < tried; ++k) count(c.verdict[k]);
       if (c.accepted < 0) continue;
       const Move& m = c.mv[c.accepted];
       const auto meets = [&](const std::pair<Vec3, Vec3>& b) {
