@@ -28,11 +28,12 @@ struct Run {
   double seconds = 0;
 };
 
-Run solve(const StickSurface& base, const SliceCurves& curves, int sweeps, bool flats) {
+Run solve(const StickSurface& base, const SliceCurves& curves, int sweeps, bool flats, double momentum) {
   StickSurface s = base;
   PressOptions po;
   po.tolerance = 0;
   po.iterations = sweeps;
+  po.momentum = momentum;
   const auto t0 = std::chrono::steady_clock::now();
   Run r;
   if (flats) {
@@ -65,21 +66,31 @@ int main(int argc, char** argv) {
   int res = 128, seeds = 1;
   bool flats = false;
   std::vector<int> budgets{100, 200, 400, 1000, 4000};
+  std::vector<double> momenta{PressOptions{}.momentum};
   app.add_option("--shape", shapes, "Generated shapes");
   app.add_option("--volume", volume_path, "A volume file instead (no truth)");
   app.add_option("--res", res, "Samples along the longest side");
   app.add_option("--seeds", seeds, "Random rotations 1..N");
   app.add_option("--iterations", budgets, "Sweep budgets of the rows (the last is the reference)");
   app.add_flag("--flats", flats, "press_with_flats instead of the plain press");
+  app.add_option("--momentum", momenta, "Heavy-ball momenta of the rows (the reference uses the first)");
   CLI11_PARSE(app, argc, argv);
-  std::printf("| case | sweeps | residual | seconds | max abs dt to ref | RMS dt | r->t RMS |\n"
-              "|---|---:|---:|---:|---:|---:|---:|\n");
+  std::printf("| case | momentum | sweeps | residual | seconds | max abs dt to ref | RMS dt | r->t RMS |\n"
+              "|---|---:|---:|---:|---:|---:|---:|---:|\n");
   auto one = [&](const std::string& name, const BinaryVolume& v, const Truth* truth) {
     const StickSurface base = extract_sticks(v);
     const SliceCurves curves = build_slice_curves(base);
     std::vector<Run> runs;
-    for (int b : budgets) runs.push_back(solve(base, curves, b, flats));
+    std::vector<double> used;
+    for (double m : momenta)
+      for (size_t k = 0; k + 1 < budgets.size(); ++k) {
+        runs.push_back(solve(base, curves, budgets[k], flats, m));
+        used.push_back(m);
+      }
+    runs.push_back(solve(base, curves, budgets.back(), flats, momenta.front()));
+    used.push_back(momenta.front());
     const Run& ref = runs.back();
+    size_t at = 0;
     auto row = [&](const Run& r) {
       double mx = 0, ss = 0;
       for (size_t i = 0; i < r.t.size(); ++i) {
@@ -87,8 +98,8 @@ int main(int argc, char** argv) {
         mx = std::max(mx, d);
         ss += d * d;
       }
-      std::printf("| %s | %d | %.1e | %.3f | %.1e | %.1e | %.4f |\n", name.c_str(), r.st.iterations, r.st.residual,
-                  r.seconds, mx, std::sqrt(ss / double(r.t.size())), rms_to_truth(base, r.t, truth, v));
+      std::printf("| %s | %.2f | %d | %.1e | %.3f | %.1e | %.1e | %.4f |\n", name.c_str(), used[at++], r.st.iterations,
+                  r.st.residual, r.seconds, mx, std::sqrt(ss / double(r.t.size())), rms_to_truth(base, r.t, truth, v));
     };
     for (const Run& r : runs) row(r);
     std::fflush(stdout);

@@ -17,14 +17,11 @@ namespace {
 // bound voxel art's simplifier used; a larger turn is a fold in the making).
 constexpr double kMinNormalDot = 0.2;
 
-// Is z swept by the triangle (a, c, d) while its corner a moves straight to
-// b, i.e. in the closed tetrahedron (a, b, c, d)? A flat sweep covers only
-// its plane: z counts within sqrt(reach2) of it (conservative).
-bool swept(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, double reach2) {
-  // First in floating point: the tetrahedron lies between the plane of
-  // (a, c, d) and b's offset from it (likewise for (b, c, d) and a); z
-  // beyond either slab by more than the rounding and the reach is not swept.
-  const double reach = std::sqrt(reach2);
+// The floating-point slab test of a sweep: the tetrahedron (a, b, c, d)
+// lies between the plane of (a, c, d) and b's offset from it (likewise for
+// (b, c, d) and a); z beyond either slab by more than the rounding and
+// `reach` is not in it.
+bool in_slabs(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, double reach) {
   for (int k = 0; k < 2; ++k) {
     const Vec3& p = k == 0 ? a : b;
     const Vec3& other = k == 0 ? b : a;
@@ -33,12 +30,29 @@ bool swept(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec
     const double e = ln * (1e-9 * ((z - p).norm() + (other - p).norm() + (c - p).norm() + (d - p).norm()) + reach);
     if (s < std::min(0.0, t) - e || s > std::max(0.0, t) + e) return false;
   }
-  const int o = orient3d(a, b, c, d);
-  if (o != 0)
-    return orient3d(z, b, c, d) * o >= 0 && orient3d(a, z, c, d) * o >= 0 && orient3d(a, b, z, d) * o >= 0 &&
-           orient3d(a, b, c, z) * o >= 0;
+  return true;
+}
+
+// Is z swept by the flat sweep of the triangle (a, c, d) whose corner a
+// moves to b in its own plane? It covers only that plane: z counts within
+// sqrt(reach2) of it (conservative).
+bool swept_flat(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, double reach2) {
+  if (!in_slabs(a, b, c, d, z, std::sqrt(reach2))) return false;
   return point_triangle_distance2(z, a, c, d) <= reach2 || point_triangle_distance2(z, b, c, d) <= reach2 ||
          point_triangle_distance2(z, a, b, c) <= reach2 || point_triangle_distance2(z, a, b, d) <= reach2;
+}
+
+// Where z lies against the tetrahedron (a, b, c, d) of orientation o != 0
+// (exact): 0 outside, o strictly inside, 2 on its boundary.
+int in_tetrahedron(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, int o) {
+  if (!in_slabs(a, b, c, d, z, 0)) return 0;
+  const int s[4] = {orient3d(z, b, c, d), orient3d(a, z, c, d), orient3d(a, b, z, d), orient3d(a, b, c, z)};
+  bool boundary = false;
+  for (int k : s) {
+    if (k == -o) return 0;
+    boundary |= k == 0;
+  }
+  return boundary ? 2 : o;
 }
 
 // A triangle with what the clash test needs: corners, vertex ids, box
@@ -193,7 +207,7 @@ bool Collapser::error_ok(const Move& m, Probe& pr) const {
 // No sample swept on the way (u to q, then v to q) nor within the
 // clearance of a final face. Only samples that exist are checked: the
 // lattice and its ring of virtual outside samples.
-bool Collapser::samples_ok(const Move& m, const Vec3& qi, const Probe& p) const {
+bool Collapser::samples_ok(const Move& m, const Vec3& qi, Probe& p) const {
   if (!o.lattice) return true;
   const double d2 = delta * delta;
   auto any = [&](std::initializer_list<Vec3> pts, auto&& hit) {
@@ -210,6 +224,18 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi, const Probe& p) const 
           if (hit(Vec3(x, y, z))) return true;
     return false;
   };
+  // A sample changes side iff the surface passes over it a net nonzero
+  // number of times: a triangle with one moving corner sweeps its
+  // tetrahedron once, with the sign of its orientation, so the sum over the
+  // two moves' tetrahedra of the signed memberships is the change of the
+  // sample's winding number (a sample swept forwards and back keeps its
+  // side). A sample on a tetrahedron's boundary, or near a flat sweep,
+  // counts as changed (conservative).
+  std::vector<std::pair<uint64_t, int>>& hits = p.hits;
+  hits.clear();
+  const auto key = [](const Vec3& z) {
+    return (uint64_t(int64_t(z.x()) + 1) << 42) | (uint64_t(int64_t(z.y()) + 1) << 21) | uint64_t(int64_t(z.z()) + 1);
+  };
   const uint32_t movers[2] = {m.u, m.v};
   for (int k = 0; k < 2; ++k) {
     const uint32_t w = movers[k];
@@ -222,8 +248,26 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi, const Probe& p) const 
       const auto corner = [&](uint32_t x) { return k == 1 && x == m.u ? qi : xi[x]; };
       const Vec3 c = corner(t[size_t((i + 1) % 3)]), d = corner(t[size_t((i + 2) % 3)]);
       if (c == qi || d == qi) continue;  // the face shrinks onto its own edge: it sweeps only itself
-      if (any({a, qi, c, d}, [&](const Vec3& z) { return swept(a, qi, c, d, z, d2); })) return false;
+      const int sense = orient3d(a, qi, c, d);
+      bool changed = false;
+      if (sense == 0) {
+        changed = any({a, qi, c, d}, [&](const Vec3& z) { return swept_flat(a, qi, c, d, z, d2); });
+      } else {
+        changed = any({a, qi, c, d}, [&](const Vec3& z) {
+          const int in = in_tetrahedron(a, qi, c, d, z, sense);
+          if (in == 2) return true;
+          if (in != 0) hits.emplace_back(key(z), in);
+          return false;
+        });
+      }
+      if (changed) return false;
     }
+  }
+  std::sort(hits.begin(), hits.end());
+  for (size_t i = 0, j = 0; i < hits.size(); i = j) {
+    int net = 0;
+    for (j = i; j < hits.size() && hits[j].first == hits[i].first; ++j) net += hits[j].second;
+    if (net != 0) return false;
   }
   for (uint32_t f : p.ring) {
     if (p.is_shared(f)) continue;

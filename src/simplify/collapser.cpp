@@ -34,6 +34,10 @@ constexpr double kGridCell = 2;
 // cost order nearly serial and the threads busy (build/bench/bench_simplify).
 constexpr uint64_t kRound = 256;
 constexpr size_t kLook = 4;
+// How far a refused collapse's q is lifted off the surface, in cells: a
+// quarter of the band between the samples (build/bench/bench_simplify
+// --shape sphere: the floor of the face count).
+constexpr double kLift = 0.25;
 
 }  // namespace
 
@@ -216,7 +220,7 @@ bool Collapser::removable(uint32_t u, uint32_t v) const {
   return it != feature.end();
 }
 
-int Collapser::moves(uint32_t a, uint32_t b, Move (&out)[3]) const {
+int Collapser::moves(uint32_t a, uint32_t b, Move* out) const {
   ErrorQuadric q = Q[a];
   q += Q[b];
   const double len2 = (xp[a] - xp[b]).squaredNorm();
@@ -232,6 +236,33 @@ int Collapser::moves(uint32_t a, uint32_t b, Move (&out)[3]) const {
   // Cheapest first; equal costs keep the order above (deterministic).
   std::stable_sort(out, out + n, [](const Move& x, const Move& y) { return x.cost < y.cost; });
   return n;
+}
+
+// Sample-aware placement (beyond Garland and Heckbert): q moved by kLift
+// cells along the patch's normal, outwards then inwards (cheaper first).
+// Only for a collapse of two free vertices that a sample refused: large
+// triangles over a curved patch cut into it by their sag, and the band
+// between the inside and the outside samples leaves room to lift them.
+int Collapser::lift(const Move& m, Move* out) const {
+  if (!o.lattice || fdeg[m.u] != 0 || fdeg[m.v] != 0) return 0;
+  Vec3 n = Vec3::Zero();
+  for (uint32_t w : {m.u, m.v})
+    for (uint32_t f : vf[w]) {
+      const Triangle& t = tri[f];
+      n += (xp[t[1]] - xp[t[0]]).cross(xp[t[2]] - xp[t[0]]);
+    }
+  if (!(n.norm() > 0)) return 0;
+  n.normalize();
+  const double h = kLift * o.lattice->spacing.minCoeff();
+  ErrorQuadric q = Q[m.u];
+  q += Q[m.v];
+  const double len2 = (xp[m.u] - xp[m.v]).squaredNorm();
+  out[0] = {0, len2, m.u, m.v, m.q + h * n};
+  out[1] = {0, len2, m.u, m.v, m.q - h * n};
+  out[0].cost = q(out[0].q);
+  out[1].cost = q(out[1].q);
+  if (out[1].cost < out[0].cost) std::swap(out[0], out[1]);
+  return 2;
 }
 
 void Collapser::neighbours(uint32_t v, std::vector<uint32_t>& out) const {
@@ -420,6 +451,14 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
         c.accepted = -1;
         for (int k = 0; k < c.n && c.accepted < 0; ++k)
           if ((c.verdict[k] = check(c.mv[k], c.probe)) == Verdict::ok) c.accepted = k;
+        // Refused for a sample: the same collapse with q lifted off the
+        // surface, either way (the chords of a curved patch cut into it).
+        if (c.accepted < 0 && c.n > 0 && std::find(c.verdict, c.verdict + c.n, Verdict::samples) != c.verdict + c.n) {
+          const int base = c.n;
+          c.n += lift(c.mv[0], c.mv + base);
+          for (int k = base; k < c.n && c.accepted < 0; ++k)
+            if ((c.verdict[k] = check(c.mv[k], c.probe)) == Verdict::ok) c.accepted = k;
+        }
       }
     });
     applied.clear();

@@ -63,23 +63,26 @@ class Collapser {
   struct Probe {
     std::vector<uint32_t> ring, shared, nu, nv, common;
     std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face)
+    std::vector<std::pair<uint64_t, int>> hits;  // samples_ok's swept samples: (sample key, sign)
     Vec3 lo, hi;
     bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
   };
   enum class Verdict : uint8_t { ok, topology, shape, error, samples, clash };
-  /// An edge of the heap taken into a round: its moves, cheapest first, and
-  /// the first that passed its checks (-1: none).
+  /// An edge of the heap taken into a round: its moves, cheapest first (and
+  /// the lifted ones, lift()), and the first that passed its checks (-1: none).
   struct Candidate {
     Entry entry;
-    Move mv[3];
-    Verdict verdict[3];
+    Move mv[5];
+    Verdict verdict[5];
     int n = 0, accepted = -1;
     Probe probe;
   };
 
   // collapser.cpp
   void build();
-  int moves(uint32_t a, uint32_t b, Move (&out)[3]) const;
+  /// The edge's moves, cheapest first, into out[0..3).
+  int moves(uint32_t a, uint32_t b, Move* out) const;
+  int lift(const Move& m, Move* out) const;
   bool removable(uint32_t u, uint32_t v) const;
   size_t select(std::priority_queue<Entry>& heap, uint64_t want);
   void apply(const Move& m, const Probe& p);
@@ -95,7 +98,7 @@ class Collapser {
   bool topology_ok(uint32_t u, uint32_t v, Probe& p) const;
   bool shape_ok(const Move& m, const Vec3& qi, const Probe& p) const;
   bool error_ok(const Move& m, Probe& p) const;
-  bool samples_ok(const Move& m, const Vec3& qi, const Probe& p) const;
+  bool samples_ok(const Move& m, const Vec3& qi, Probe& p) const;
   bool clash_free(const Move& m, const Vec3& qi, Probe& p) const;
   void box_of(uint32_t f, Vec3& lo, Vec3& hi) const;
   Vec3 at_index(uint32_t w, const Move& m, const Vec3& qi) const { return w == m.u || w == m.v ? qi : xi[w]; }
