@@ -331,6 +331,127 @@ std::vector<uint8_t> flat_places(const SharedSurface& s, const SharedFlats& flat
   return placed;
 }
 
+// Press levels for the extent of the surface's cells.
+int shared_press_levels(const SharedSurface& s, const PressOptions& o) {
+  const size_t n = s.mesh.positions.size();
+  int64_t extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    int64_t lo = INT64_MAX, hi = INT64_MIN;
+    for (const auto& c : s.corner) lo = std::min(lo, c[size_t(a)]), hi = std::max(hi, c[size_t(a)]);
+    if (n > 0) extent = std::max(extent, hi + 2 - lo);
+  }
+  return press_levels_for_extent(o.levels, extent);
+}
+
+// Labels around each junction vertex, up to four: their count.
+std::vector<uint8_t> labels_around(const SharedSurface& s, const Graph& jg) {
+  const size_t n = s.mesh.positions.size();
+  std::vector<std::array<uint32_t, 4>> around(n);
+  std::vector<uint8_t> count(n, 0);
+  for (size_t f = 0; f < s.sides.size(); ++f)
+    for (uint32_t v : s.mesh.triangles[f])
+      for (uint32_t L : s.sides[f]) {
+        if (jg.degree(v) == 0 || count[v] == 4) continue;
+        if (std::find(around[v].begin(), around[v].begin() + count[v], L) == around[v].begin() + count[v])
+          around[v][count[v]++] = L;
+      }
+  return count;
+}
+
+// CSR curves for the iteration: an open chain J1 .. J2 as a cycle whose
+// closing segment J2 -> J1 joins two barriers (no vertex between them);
+// a chain continued through a junction point by another (partner) as an
+// open polyline with that piece as context beyond the point.
+void add_plane_curves(const Chains& pc, const std::vector<int64_t>& partner, const PressOptions& o, detail::Family& f,
+                      std::vector<uint32_t>& ids, std::vector<uint32_t>& offsets, SharedPressStats& st) {
+  for (size_t k = 0; k < pc.closed.size(); ++k) {
+    uint32_t b = pc.offsets[k], e = pc.offsets[k + 1];
+    const int64_t before = pc.closed[k] ? -1 : partner[2 * k], after = pc.closed[k] ? -1 : partner[2 * k + 1];
+    if (before < 0 && after < 0) {
+      if (!pc.closed[k] && pc.ids[e - 1] == pc.ids[b]) --e;
+      ids.insert(ids.end(), pc.ids.begin() + b, pc.ids.begin() + e);
+      offsets.push_back(uint32_t(ids.size()));
+      f.spans.push_back({});
+      continue;
+    }
+    // The partner chain's vertices from its end at the junction point
+    // (excluded) away from it.
+    auto away = [&](int64_t end) {
+      const size_t q = size_t(end / 2);
+      const uint32_t qb = pc.offsets[q], qe = pc.offsets[q + 1];
+      std::vector<uint32_t> out(pc.ids.begin() + qb, pc.ids.begin() + qe);
+      if (end % 2 == 1) std::reverse(out.begin(), out.end());
+      out.erase(out.begin());
+      return out;
+    };
+    const size_t start = ids.size();
+    const bool loose = o.free_ends && e - b - 1 >= detail::kFreePiece;
+    if (before >= 0) {
+      std::vector<uint32_t> c = away(before);
+      ids.insert(ids.end(), c.rbegin(), c.rend());
+    }
+    // The junction point itself is left out where the curve goes on
+    // through it: its place (stage 1, inside its face square) would bend
+    // the continued curve towards it.
+    const uint32_t first = before >= 0 || loose ? b + 1 : b, last = after >= 0 || loose ? e - 1 : e;
+    detail::Family::Span sp;
+    sp.open = 1;
+    sp.free = loose;
+    sp.lo = uint32_t(ids.size() - start) + (first == b ? 1 : 0);
+    ids.insert(ids.end(), pc.ids.begin() + first, pc.ids.begin() + last);
+    sp.hi = uint32_t(ids.size() - start) - (last == e ? 1 : 0);
+    if (after >= 0) {
+      std::vector<uint32_t> c = away(after);
+      ids.insert(ids.end(), c.begin(), c.end());
+    }
+    offsets.push_back(uint32_t(ids.size()));
+    f.spans.push_back(sp);
+    ++st.continued;
+  }
+}
+
+// The labelled contours of the lattice planes normal to axis a, cut at the
+// barriers, as iteration family f over ids and offsets (CSR).
+void plane_family(const SharedSurface& s, int a, const std::vector<Edge>& edges, const std::vector<uint8_t>& barrier,
+                  const Graph& jg, const std::vector<Vec3>& x0, const Mat3& M, const PressOptions& o, detail::Family& f,
+                  std::vector<uint32_t>& ids, std::vector<uint32_t>& offsets, SharedPressStats& st) {
+  const size_t n = s.mesh.positions.size();
+  const int u = (a + 1) % 3, w = (a + 2) % 3;
+  std::vector<std::pair<uint32_t, uint32_t>> in_plane;
+  for (const Edge& e : edges) {
+    const int64_t p = plane_of(s, e.u, a);
+    if (p != INT64_MIN && p == plane_of(s, e.v, a)) in_plane.push_back({e.u, e.v});
+  }
+  const Graph g(n, in_plane);
+  std::vector<uint32_t> mem;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (plane_of(s, v, a) == INT64_MIN) continue;
+    if (is_stick(s.kind[v]) && g.degree(v) != 2)
+      throw std::logic_error("press_shared: a stick vertex without two neighbours in a plane");
+    mem.push_back(v);
+  }
+  const Chains pc = chains_of(g, barrier, mem);
+  const std::vector<int64_t> partner = continuations(s, pc, jg, x0, M);
+  add_plane_curves(pc, partner, o, f, ids, offsets, st);
+  offsets.insert(offsets.begin(), 0u);
+  st.plane_curves += pc.closed.size();
+  f.ids = &ids;
+  f.offsets = &offsets;
+  f.g = {M.col(u).squaredNorm(), M.col(u).dot(M.col(w)), M.col(w).squaredNorm()};
+  f.cell = std::sqrt(s.lattice.spacing[u] * s.lattice.spacing[w]);
+  const size_t m = ids.size();
+  f.base.resize(m);
+  f.mov.resize(m);
+  f.dst.resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    const uint32_t v = ids[k];
+    const uint8_t kind = s.kind[v];
+    f.mov[k] = uint8_t(is_stick(kind) && kind != u ? 1 : 0);
+    f.dst[k] = 2 * v + uint32_t(is_stick(kind) ? SliceCurves::slot(a, kind) : 0);
+    if (is_stick(kind)) f.base[k] = Vec2(double(s.corner[v][size_t(u)]), double(s.corner[v][size_t(w)]));
+  }
+}
+
 }  // namespace
 
 SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const SharedFlats* flats) {
@@ -347,13 +468,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
     x0[v] = s.lattice.to_index(s.mesh.positions[v]);
     if (is_stick(s.kind[v])) t0s[v] = x0[v][s.kind[v]] - double(s.corner[v][s.kind[v]]);
   });
-  int64_t extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    int64_t lo = INT64_MAX, hi = INT64_MIN;
-    for (const auto& c : s.corner) lo = std::min(lo, c[size_t(a)]), hi = std::max(hi, c[size_t(a)]);
-    if (n > 0) extent = std::max(extent, hi + 2 - lo);
-  }
-  const int levels = press_levels_for_extent(o.levels, extent);
+  const int levels = shared_press_levels(s, o);
   const std::vector<Edge> edges = edges_of(s.mesh);
 
   // Junction lines: edges with three or more triangles.
@@ -361,16 +476,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   for (const Edge& e : edges)
     if (e.count >= 3) junction.push_back({e.u, e.v});
   const Graph jg(n, junction);
-  // Labels around each junction vertex, up to four.
-  std::vector<std::array<uint32_t, 4>> around(n);
-  std::vector<uint8_t> count(n, 0);
-  for (size_t f = 0; f < s.sides.size(); ++f)
-    for (uint32_t v : s.mesh.triangles[f])
-      for (uint32_t L : s.sides[f]) {
-        if (jg.degree(v) == 0 || count[v] == 4) continue;
-        if (std::find(around[v].begin(), around[v].begin() + count[v], L) == around[v].begin() + count[v])
-          around[v][count[v]++] = L;
-      }
+  const std::vector<uint8_t> count = labels_around(s, jg);
   std::vector<uint32_t> members;
   for (uint32_t v = 0; v < n; ++v)
     if (jg.degree(v) > 0) members.push_back(v);
@@ -387,90 +493,8 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   std::vector<detail::Family> families(3);
   std::vector<uint32_t> ids[3], offsets[3];
   const Mat3 M = s.lattice.index_to_physical_matrix();
-  for (int a = 0; a < 3; ++a) {
-    const int u = (a + 1) % 3, w = (a + 2) % 3;
-    std::vector<std::pair<uint32_t, uint32_t>> in_plane;
-    for (const Edge& e : edges) {
-      const int64_t p = plane_of(s, e.u, a);
-      if (p != INT64_MIN && p == plane_of(s, e.v, a)) in_plane.push_back({e.u, e.v});
-    }
-    const Graph g(n, in_plane);
-    std::vector<uint32_t> mem;
-    for (uint32_t v = 0; v < n; ++v) {
-      if (plane_of(s, v, a) == INT64_MIN) continue;
-      if (is_stick(s.kind[v]) && g.degree(v) != 2)
-        throw std::logic_error("press_shared: a stick vertex without two neighbours in a plane");
-      mem.push_back(v);
-    }
-    const Chains pc = chains_of(g, barrier, mem);
-    const std::vector<int64_t> partner = continuations(s, pc, jg, x0, M);
-    detail::Family& f = families[size_t(a)];
-    // CSR curves for the iteration: an open chain J1 .. J2 as a cycle whose
-    // closing segment J2 -> J1 joins two barriers (no vertex between them);
-    // a chain continued through a junction point by another (partner) as an
-    // open polyline with that piece as context beyond the point.
-    for (size_t k = 0; k < pc.closed.size(); ++k) {
-      uint32_t b = pc.offsets[k], e = pc.offsets[k + 1];
-      const int64_t before = pc.closed[k] ? -1 : partner[2 * k], after = pc.closed[k] ? -1 : partner[2 * k + 1];
-      if (before < 0 && after < 0) {
-        if (!pc.closed[k] && pc.ids[e - 1] == pc.ids[b]) --e;
-        ids[a].insert(ids[a].end(), pc.ids.begin() + b, pc.ids.begin() + e);
-        offsets[a].push_back(uint32_t(ids[a].size()));
-        f.spans.push_back({});
-        continue;
-      }
-      // The partner chain's vertices from its end at the junction point
-      // (excluded) away from it.
-      auto away = [&](int64_t end) {
-        const size_t q = size_t(end / 2);
-        const uint32_t qb = pc.offsets[q], qe = pc.offsets[q + 1];
-        std::vector<uint32_t> out(pc.ids.begin() + qb, pc.ids.begin() + qe);
-        if (end % 2 == 1) std::reverse(out.begin(), out.end());
-        out.erase(out.begin());
-        return out;
-      };
-      const size_t start = ids[a].size();
-      const bool loose = o.free_ends && e - b - 1 >= detail::kFreePiece;
-      if (before >= 0) {
-        std::vector<uint32_t> c = away(before);
-        ids[a].insert(ids[a].end(), c.rbegin(), c.rend());
-      }
-      // The junction point itself is left out where the curve goes on
-      // through it: its place (stage 1, inside its face square) would bend
-      // the continued curve towards it.
-      const uint32_t first = before >= 0 || loose ? b + 1 : b, last = after >= 0 || loose ? e - 1 : e;
-      detail::Family::Span sp;
-      sp.open = 1;
-      sp.free = loose;
-      sp.lo = uint32_t(ids[a].size() - start) + (first == b ? 1 : 0);
-      ids[a].insert(ids[a].end(), pc.ids.begin() + first, pc.ids.begin() + last);
-      sp.hi = uint32_t(ids[a].size() - start) - (last == e ? 1 : 0);
-      if (after >= 0) {
-        std::vector<uint32_t> c = away(after);
-        ids[a].insert(ids[a].end(), c.begin(), c.end());
-      }
-      offsets[a].push_back(uint32_t(ids[a].size()));
-      f.spans.push_back(sp);
-      ++st.continued;
-    }
-    offsets[a].insert(offsets[a].begin(), 0u);
-    st.plane_curves += pc.closed.size();
-    f.ids = &ids[a];
-    f.offsets = &offsets[a];
-    f.g = {M.col(u).squaredNorm(), M.col(u).dot(M.col(w)), M.col(w).squaredNorm()};
-    f.cell = std::sqrt(s.lattice.spacing[u] * s.lattice.spacing[w]);
-    const size_t m = ids[a].size();
-    f.base.resize(m);
-    f.mov.resize(m);
-    f.dst.resize(m);
-    for (size_t k = 0; k < m; ++k) {
-      const uint32_t v = ids[a][k];
-      const uint8_t kind = s.kind[v];
-      f.mov[k] = uint8_t(is_stick(kind) && kind != u ? 1 : 0);
-      f.dst[k] = 2 * v + uint32_t(is_stick(kind) ? SliceCurves::slot(a, kind) : 0);
-      if (is_stick(kind)) f.base[k] = Vec2(double(s.corner[v][size_t(u)]), double(s.corner[v][size_t(w)]));
-    }
-  }
+  for (int a = 0; a < 3; ++a)
+    plane_family(s, a, edges, barrier, jg, x0, M, o, families[size_t(a)], ids[a], offsets[a], st);
 
   const Cubes cubes = detail::cubes_of(s.mesh, x0);
   const double delta = detail::float32_clearance(s.lattice);
