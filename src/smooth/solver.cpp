@@ -26,7 +26,11 @@
 // energy with frozen resampling weights minimized by projected Newton
 // converged 10 % per outer step at 10-250 times the cost. The CAD part's
 // residual was a loop around one sample in a 2-cycle (curve_kernel.h: tiny
-// loops now shrink d continuously); what is left there is not yet traced.
+// loops now shrink d continuously); what is left there is a few soft
+// sliding vertices (a stick nearly along its curve) drifting slowly, and on
+// a sphere the bilaplacian's mid-length waves between contacts ~10 cells
+// apart (about 1 % of the vertices are clamped at the fixed point): a heavier
+// momentum only makes the residual ring (BENCHMARKS.md, The solver).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
