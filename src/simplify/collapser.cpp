@@ -265,6 +265,14 @@ int Collapser::lift(const Move& m, Move* out) const {
   return 2;
 }
 
+bool Collapser::entry_of(uint32_t a, uint32_t b, Entry& out) const {
+  Move mv[3];
+  if (moves(a, b, mv) == 0) return false;
+  const uint32_t lo = std::min(a, b), hi = std::max(a, b);
+  out = {mv[0].cost, mv[0].len2, lo, hi, stamp[lo], stamp[hi]};
+  return true;
+}
+
 void Collapser::neighbours(uint32_t v, std::vector<uint32_t>& out) const {
   out.clear();
   for (uint32_t f : vf[v])
@@ -378,7 +386,6 @@ size_t Collapser::select(std::priority_queue<Entry>& heap, uint64_t want) {
     for (uint32_t w : around) claim_[w] = round_id_;
     for (uint32_t w : ring_b) claim_[w] = round_id_;
     Candidate& c = round_[n++];
-    c.entry = e;
     c.n = moves(e.a, e.b, c.mv);
   }
   for (const Entry& e : later) heap.push(e);
@@ -417,10 +424,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     for (size_t f = r.begin(); f < r.end(); ++f)
       for (size_t c = 0; c < 3; ++c) {
         const uint32_t a = tri[f][c], b = tri[f][(c + 1) % 3];
-        Move mv[3];
-        if (a > b || moves(a, b, mv) == 0) continue;
-        first[3 * f + c] = {mv[0].cost, mv[0].len2, a, b, stamp[a], stamp[b]};
-        has[3 * f + c] = 1;
+        has[3 * f + c] = a < b && entry_of(a, b, first[3 * f + c]);
       }
   });
   size_t edges = 0;
@@ -449,15 +453,17 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         Candidate& c = round_[i];
         c.accepted = -1;
-        for (int k = 0; k < c.n && c.accepted < 0; ++k)
-          if ((c.verdict[k] = check(c.mv[k], c.probe)) == Verdict::ok) c.accepted = k;
+        const auto try_from = [&](int first_move) {  // the first of mv[first_move..n) to pass
+          for (int k = first_move; k < c.n && c.accepted < 0; ++k)
+            if ((c.verdict[k] = check(c.mv[k], c.probe)) == Verdict::ok) c.accepted = k;
+        };
+        try_from(0);
         // Refused for a sample: the same collapse with q lifted off the
         // surface, either way (the chords of a curved patch cut into it).
         if (c.accepted < 0 && c.n > 0 && std::find(c.verdict, c.verdict + c.n, Verdict::samples) != c.verdict + c.n) {
           const int base = c.n;
           c.n += lift(c.mv[0], c.mv + base);
-          for (int k = base; k < c.n && c.accepted < 0; ++k)
-            if ((c.verdict[k] = check(c.mv[k], c.probe)) == Verdict::ok) c.accepted = k;
+          try_from(base);
         }
       }
     });
@@ -492,12 +498,9 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
         const uint32_t v = kept[i];
         fresh[i].clear();
         neighbours(v, nb);
-        for (uint32_t w : nb) {
-          Move mv[3];
-          if (moves(v, w, mv) == 0) continue;
-          const uint32_t a = std::min(v, w), b = std::max(v, w);
-          fresh[i].push_back({mv[0].cost, mv[0].len2, a, b, stamp[a], stamp[b]});
-        }
+        Entry e;
+        for (uint32_t w : nb)
+          if (entry_of(v, w, e)) fresh[i].push_back(e);
       }
     });
     for (const auto& entries : fresh)

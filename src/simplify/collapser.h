@@ -71,7 +71,6 @@ class Collapser {
   /// An edge of the heap taken into a round: its moves, cheapest first (and
   /// the lifted ones, lift()), and the first that passed its checks (-1: none).
   struct Candidate {
-    Entry entry;
     Move mv[5];
     Verdict verdict[5];
     int n = 0, accepted = -1;
@@ -82,6 +81,8 @@ class Collapser {
   void build();
   /// The edge's moves, cheapest first, into out[0..3).
   int moves(uint32_t a, uint32_t b, Move* out) const;
+  /// The heap entry of edge (a, b): its cheapest move's cost; false when it has no move.
+  bool entry_of(uint32_t a, uint32_t b, Entry& out) const;
   int lift(const Move& m, Move* out) const;
   bool removable(uint32_t u, uint32_t v) const;
   size_t select(std::priority_queue<Entry>& heap, uint64_t want);
