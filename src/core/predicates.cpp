@@ -172,6 +172,16 @@ int orient2d_drop(const Vec3& a, const Vec3& b, const Vec3& c, int drop) {
   return orient2d(a[u], a[v], b[u], b[v], c[u], c[v]);
 }
 
+int tetrahedron_side(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, int o) {
+  bool boundary = false;
+  for (int k = 0; k < 4; ++k) {
+    const int s = orient3d(k == 0 ? z : a, k == 1 ? z : b, k == 2 ? z : c, k == 3 ? z : d);
+    if (s == -o) return -1;
+    boundary |= s == 0;
+  }
+  return boundary ? 0 : 1;
+}
+
 bool triangle_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) {
   return orient2d_drop(a, b, c, 0) == 0 && orient2d_drop(a, b, c, 1) == 0 && orient2d_drop(a, b, c, 2) == 0;
 }

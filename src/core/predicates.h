@@ -26,6 +26,10 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy);
 /// the remaining axes keep their cyclic order ((1,2), (2,0), (0,1)).
 int orient2d_drop(const Vec3& a, const Vec3& b, const Vec3& c, int drop);
 
+/// z against the tetrahedron (a, b, c, d) of orientation o = orient3d(a, b,
+/// c, d) != 0: -1 outside, 0 on its boundary, +1 strictly inside.
+int tetrahedron_side(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, int o);
+
 /// True when the triangle's three corners are collinear (or coincide).
 bool triangle_degenerate(const Vec3& a, const Vec3& b, const Vec3& c);
 

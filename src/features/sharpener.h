@@ -57,8 +57,7 @@ inline uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, 
 inline bool in_closed_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z) {
   const int o = detail::orient3d(a, b, c, d);
   if (o == 0) return detail::orient3d(a, c, d, z) == 0 || detail::orient3d(b, c, d, z) == 0;
-  return detail::orient3d(z, b, c, d) * o >= 0 && detail::orient3d(a, z, c, d) * o >= 0 &&
-         detail::orient3d(a, b, z, d) * o >= 0 && detail::orient3d(a, b, c, z) * o >= 0;
+  return detail::tetrahedron_side(a, b, c, d, z, o) >= 0;
 }
 
 // The point nearest x0 that best satisfies the planes in the least-squares

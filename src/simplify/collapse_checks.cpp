@@ -46,13 +46,8 @@ bool swept_flat(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, cons
 // (exact): 0 outside, o strictly inside, 2 on its boundary.
 int in_tetrahedron(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& z, int o) {
   if (!in_slabs(a, b, c, d, z, 0)) return 0;
-  const int s[4] = {orient3d(z, b, c, d), orient3d(a, z, c, d), orient3d(a, b, z, d), orient3d(a, b, c, z)};
-  bool boundary = false;
-  for (int k : s) {
-    if (k == -o) return 0;
-    boundary |= k == 0;
-  }
-  return boundary ? 2 : o;
+  const int side = tetrahedron_side(a, b, c, d, z, o);
+  return side < 0 ? 0 : side == 0 ? 2 : o;
 }
 
 // A triangle with what the clash test needs: corners, vertex ids, box
