@@ -3,9 +3,11 @@
 // curvature test. Theory of operation: include/voxpress/features/flats.h.
 #pragma once
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <vector>
 
@@ -403,5 +405,39 @@ struct Detector {
     return kappa * (hi - lo) <= detail::kFlatMaxBend * kPi / 180;
   }
 };
+
+// ------------------------------------------------------------ find_flats' stages
+// What the stages of find_flats share: the input, the estimate's surface,
+// the segmentation being built and the serial detector (its rim flags).
+// Detection (votes, greedy extraction, merge) is in find_flats.cpp; the
+// junctions, the extension to the sharp edges, the rim release, the sizes
+// and the barriers in flat_junctions.cpp.
+struct FlatsContext {
+  FlatsContext(const StickSurface& surface, const std::vector<double>& estimate, const FlatOptions& options,
+               FlatSegmentation& out);
+  const StickSurface& s;
+  const FlatOptions& o;
+  FlatSegmentation& seg;
+  const size_t n;  // sticks
+  const Surface S;
+  const double cone, cos_cone;  // the voting cone (kFlatCone), in radians, and its cosine
+  const Mat3 M, Minv_t;         // index -> physical, and its inverse transposed
+  const double cell;            // the physical cell's size (cube root of its volume)
+  const double cos_j;           // cosine of junction_angle
+  Detector det;                 // the greedy loop's: accepted flats' rim flags; the merge grows with it
+  tbb::enumerable_thread_specific<detail::RingScratch> scratch;  // the junction and tangent tests' rings
+  // The last detection's smooth borders (tangent-borders) and junction
+  // planes of the off-plane points (ring-off-plane).
+  std::atomic<size_t> smooth_borders{0}, off_plane_junctions{0};
+
+  Flat flat_of(const Plane& P) const;
+  double frozen_t(uint32_t v, const Plane& P) const;
+};
+
+// The stages after detection (flat_junctions.cpp), in find_flats' order.
+void extend_to_edges(FlatsContext& ctx);
+void release_rim(FlatsContext& ctx);
+void measure_flats(FlatsContext& ctx);
+void mark_barriers(FlatsContext& ctx, const SliceCurves& curves);
 
 }  // namespace voxpress::flats_impl
