@@ -431,6 +431,13 @@ struct FlatsContext {
   std::atomic<size_t> smooth_borders{0}, off_plane_junctions{0};
 
   Flat flat_of(const Plane& P) const;
+  // Physical height of index point x over flat F's plane, from its index
+  // plane: F.offset includes the lattice's origin and the tests' points
+  // (M x) do not, and the index plane does not depend on where the lattice
+  // lies (Invariance.MovedOriginGivesTheSameT).
+  double height(const Flat& F, const Vec3& x) const {
+    return (F.index_normal.dot(x) - F.index_offset) / (Minv_t * F.index_normal).norm();
+  }
   double frozen_t(uint32_t v, const Plane& P) const;
 };
 

@@ -61,12 +61,12 @@ bool tangent(const FlatsContext& ctx, uint32_t v, int32_t f, double cos_max, dou
   const Flat& F = ctx.seg.flats[size_t(f)];
   if (min_rise > 0) {
     double rise = 0;
-    for (const Vec3& p : pts) rise = std::max(rise, std::abs(F.normal.dot(p) - F.offset));
+    for (const auto& [w, d] : rs.out)
+      if (d >= kTangentRings[0]) rise = std::max(rise, std::abs(ctx.height(F, S.x[w])));
     if (rise < min_rise * ctx.cell) return false;
   }
   if (!Q.fit(pts, outward) || Q.residual > detail::kTangentResidual * ctx.cell) return false;
-  const Vec3 p = M * S.x[v];
-  const Vec3 foot = p - (F.normal.dot(p) - F.offset) * F.normal;
+  const Vec3 foot = M * S.x[v] - ctx.height(F, S.x[v]) * F.normal;
   return std::abs(Q.normal_at(foot).dot(F.normal)) >= cos_max;
 }
 
@@ -99,8 +99,8 @@ bool is_junction(FlatsContext& ctx, size_t v, int32_t f0, detail::RingScratch& r
     if (o.passes.on(Pass::ring_off_plane)) {
       const Flat& F = seg.flats[size_t(f0)];
       for (const auto& [w, d] : rs.out) {
-        const Vec3 p = M * S.x[w];
-        if (w == v || std::abs(F.normal.dot(p) - F.offset) > detail::kJunctionRingOffPlane * ctx.cell) pts.push_back(p);
+        if (w == v || std::abs(ctx.height(F, S.x[w])) > detail::kJunctionRingOffPlane * ctx.cell)
+          pts.push_back(M * S.x[w]);
       }
       if (pts.size() >= 3) {
         q = pca(pts);
