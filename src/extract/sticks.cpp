@@ -23,6 +23,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <chrono>
@@ -132,6 +133,55 @@ std::array<int64_t, 3> StickSurface::lower_index(size_t s) const {
   const uint64_t l = lower[s];
   const uint64_t px = uint64_t(padded[0]), py = uint64_t(padded[1]);
   return {int64_t(l % px) - 1, int64_t((l / px) % py) - 1, int64_t(l / (px * py)) - 1};
+}
+
+namespace {
+
+// The sticks re-indexed on lattice `to`, whose sample 0 is their sample
+// `at` (same sticks, order and t; only the index frame moves).
+StickSurface moved_to(StickSurface s, const Lattice& to, const std::array<int64_t, 3>& at) {
+  const uint64_t ox = uint64_t(s.padded[0]), oy = uint64_t(s.padded[1]);
+  s.lattice = to;
+  for (size_t a = 0; a < 3; ++a) s.padded[a] = to.dims[a] + 2;
+  const uint64_t px = uint64_t(s.padded[0]), py = uint64_t(s.padded[1]);
+  tbb::parallel_for(size_t(0), s.stick_count(), [&](size_t i) {
+    const uint64_t l = s.lower[i];
+    const uint64_t x = uint64_t(int64_t(l % ox) - at[0]), y = uint64_t(int64_t((l / ox) % oy) - at[1]),
+                   z = uint64_t(int64_t(l / (ox * oy)) - at[2]);
+    s.lower[i] = x + px * (y + py * z);
+  });
+  return s;
+}
+
+}  // namespace
+
+StickSurface on_own_box(StickSurface s, OwnBox* frame) {
+  const size_t n = s.stick_count();
+  if (frame) *frame = {s.lattice, {0, 0, 0}};
+  if (n == 0) return s;
+  using Bounds = std::array<int64_t, 6>;  // min, then max, of each coordinate
+  const Bounds box = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, n, 1 << 14), Bounds{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MIN, INT64_MIN, INT64_MIN},
+      [&](const tbb::blocked_range<size_t>& r, Bounds b) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          const auto l = s.lower_index(i);
+          for (size_t a = 0; a < 3; ++a) b[a] = std::min(b[a], l[a]), b[a + 3] = std::max(b[a + 3], l[a]);
+        }
+        return b;
+      },
+      [](Bounds x, const Bounds& y) {
+        for (size_t a = 0; a < 3; ++a) x[a] = std::min(x[a], y[a]), x[a + 3] = std::max(x[a + 3], y[a + 3]);
+        return x;
+      });
+  Lattice own = s.lattice;
+  own.origin = s.lattice.to_physical(Vec3(double(box[0]), double(box[1]), double(box[2])));
+  for (size_t a = 0; a < 3; ++a) own.dims[a] = box[a + 3] + 2 - box[a];  // a stick's upper sample lies one past its lower one
+  if (frame) frame->lo = {box[0], box[1], box[2]};
+  return moved_to(std::move(s), own, {box[0], box[1], box[2]});
+}
+
+StickSurface off_own_box(StickSurface s, const OwnBox& frame) {
+  return moved_to(std::move(s), frame.lattice, {-frame.lo[0], -frame.lo[1], -frame.lo[2]});
 }
 
 Vec3 StickSurface::index_position(size_t s) const {

@@ -73,20 +73,23 @@ int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out) {
   frame(n, u, v);
   const double r = std::tan(0.7 * cone);
   static const auto ring = [] {  // cos and sin of the six directions' angles
-    std::array<std::array<double, 2>, kMaxVotes> cs{};
-    for (int k = 1; k < kMaxVotes; ++k) cs[size_t(k)] = {std::cos(k * kPi / 3), std::sin(k * kPi / 3)};
+    std::array<std::array<double, 2>, kDirections> cs{};
+    for (int k = 1; k < kDirections; ++k) cs[size_t(k)] = {std::cos(k * kPi / 3), std::sin(k * kPi / 3)};
     return cs;
   }();
   int count = 0;
-  for (int k = 0; k < kMaxVotes; ++k) {
+  for (int k = 0; k < kDirections; ++k) {
     const auto& [c_k, s_k] = ring[size_t(k)];
     const Vec3 d = k == 0 ? n : Vec3((n + r * (c_k * u + s_k * v)).normalized());
     const uint32_t c = direction_cell(d);
     const double off = cell_direction(c).dot(x);
-    const uint64_t key = (uint64_t(c) << 32) | uint32_t(int64_t(std::floor(off)) + (int64_t(1) << 30));
-    bool dup = false;
-    for (int q = 0; q < count; ++q) dup |= out[q] == key;
-    if (!dup) out[count++] = key;
+    for (uint32_t grid = 0; grid < 2; ++grid) {  // bit 31 of the bin word: the staggered grid
+      const int64_t bin = int64_t(std::floor(off + 0.5 * grid)) + (int64_t(1) << 29);
+      const uint64_t key = (uint64_t(c) << 32) | (uint64_t(grid) << 31) | uint32_t(bin);
+      bool dup = false;
+      for (int q = 0; q < count; ++q) dup |= out[q] == key;
+      if (!dup) out[count++] = key;
+    }
   }
   return count;
 }
@@ -112,14 +115,14 @@ Votes cast_votes(const Surface& S, double cone) {
   // counting sort by direction cell (each bucket keeps the voters in
   // order), then each bucket sorted by offset bin, (bin, voter) packed in
   // one word. Runs of one key are the accumulator's cells.
-  constexpr size_t kDirections = 6 * kCube * kCube;
-  std::vector<uint64_t> bucket(kDirections + 1, 0);
+  constexpr size_t kCells = 6 * kCube * kCube;  // direction cells
+  std::vector<uint64_t> bucket(kCells + 1, 0);
   for (size_t v = 0; v < n; ++v) {
     V.voters += V.count[v] > 0;
     for (uint32_t q = 0; q < V.count[v]; ++q) ++bucket[(keys[v * kMaxVotes + q] >> 32) + 1];
   }
-  for (size_t c = 0; c < kDirections; ++c) bucket[c + 1] += bucket[c];
-  V.votes = bucket[kDirections];
+  for (size_t c = 0; c < kCells; ++c) bucket[c + 1] += bucket[c];
+  V.votes = bucket[kCells];
   std::vector<uint64_t> sorted(V.votes);  // offset bin << 32 | voter
   {
     std::vector<uint64_t> at(bucket.begin(), bucket.end() - 1);
@@ -129,11 +132,11 @@ Votes cast_votes(const Surface& S, double cone) {
         sorted[at[key >> 32]++] = (key << 32) | v;
       }
   }
-  tbb::parallel_for(size_t(0), kDirections, [&](size_t c) {
+  tbb::parallel_for(size_t(0), kCells, [&](size_t c) {
     std::sort(sorted.begin() + ptrdiff_t(bucket[c]), sorted.begin() + ptrdiff_t(bucket[c + 1]));
   });
   V.voter.resize(V.votes);
-  for (size_t d = 0; d < kDirections; ++d)
+  for (size_t d = 0; d < kCells; ++d)
     for (uint64_t i = bucket[d]; i < bucket[d + 1]; ++i) {
       V.voter[i] = uint32_t(sorted[i]);
       const uint64_t key = (uint64_t(d) << 32) | (sorted[i] >> 32);

@@ -99,7 +99,12 @@ Vec3 cell_direction(uint32_t c);
 // Unit vectors spanning the plane orthogonal to unit n.
 void frame(const Vec3& n, Vec3& u, Vec3& v);
 
-constexpr int kMaxVotes = 7;  // a vertex's votes: its normal's cell and six around it
+constexpr int kDirections = 7;  // a vertex's vote directions: its normal's cell and six around it
+// Each direction votes in two offset bins, one of each of two grids of unit
+// bins staggered by half a bin: a plane whose offsets straddle one grid's
+// bin border lies inside a bin of the other, so where the lattice's origin
+// falls does not split a face's votes (and a shifted volume votes alike).
+constexpr int kMaxVotes = 2 * kDirections;
 int votes_of(const Vec3& n, const Vec3& x, double cone, uint64_t* out);
 
 // ---------------------------------------------------------------- planes

@@ -200,19 +200,22 @@ bool Collapser::error_ok(const Move& m, Probe& pr) const {
 }
 
 // No sample swept on the way (u to q, then v to q) nor within the
-// clearance of a final face. Only samples that exist are checked: the
-// lattice and its ring of virtual outside samples.
+// clearance of a final face. Every lattice point is a sample (beyond the
+// volume, an outside one), so where the volume ends does not matter.
 bool Collapser::samples_ok(const Move& m, const Vec3& qi, Probe& p) const {
   if (!o.lattice) return true;
   const double d2 = delta * delta;
+  constexpr double kKeySpan = double((int64_t(1) << 21) - 1);
   auto any = [&](std::initializer_list<Vec3> pts, auto&& hit) {
     Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
     for (const Vec3& x : pts) {
       lo = lo.cwiseMin(x);
       hi = hi.cwiseMax(x);
     }
-    lo = (lo.array() - delta).ceil().max(sample_lo.array());
-    hi = (hi.array() + delta).floor().min(sample_hi.array());
+    lo = (lo.array() - delta).ceil();
+    hi = (hi.array() + delta).floor();
+    if (((lo - key_base).array() < 0).any() || ((hi - key_base).array() >= kKeySpan).any())
+      return true;  // past the keys' range: refused
     for (double z = lo.z(); z <= hi.z(); ++z)
       for (double y = lo.y(); y <= hi.y(); ++y)
         for (double x = lo.x(); x <= hi.x(); ++x)
@@ -228,8 +231,9 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi, Probe& p) const {
   // counts as changed (conservative).
   std::vector<std::pair<uint64_t, int>>& hits = p.hits;
   hits.clear();
-  const auto key = [](const Vec3& z) {
-    return (uint64_t(int64_t(z.x()) + 1) << 42) | (uint64_t(int64_t(z.y()) + 1) << 21) | uint64_t(int64_t(z.z()) + 1);
+  const auto key = [&](const Vec3& z) {
+    const Vec3 k = z - key_base;
+    return (uint64_t(k.x()) << 42) | (uint64_t(k.y()) << 21) | uint64_t(k.z());
   };
   const uint32_t movers[2] = {m.u, m.v};
   for (int k = 0; k < 2; ++k) {

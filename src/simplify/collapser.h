@@ -120,7 +120,11 @@ class Collapser {
   FaceGrid grid;
   uint64_t grid_faces = 0;  // alive faces when the grid was last built
   double delta = 0;                                // index-space clearance
-  Vec3 sample_lo, sample_hi;                       // the samples that exist (the lattice and its padding ring)
+  // Samples are keyed by their offset from key_base (the mesh's box less
+  // kKeyRoom cells), 21 bits per axis; a sweep reaching past that range is
+  // refused (conservative).
+  static constexpr int64_t kKeyRoom = 1 << 10;
+  Vec3 key_base = Vec3::Zero();
   uint64_t alive_faces = 0;
   std::vector<Candidate> round_;      // the moves of the current round
   std::vector<uint32_t> claim_;       // per vertex: the last round whose footprint holds it

@@ -133,7 +133,12 @@ void require_float32_room(const Lattice& lattice, const SurfaceOptions& o, const
                              " cells; move the origin closer to the volume)");
 }
 
-void press_stick_surface(StickSurface& surface, const SurfaceOptions& o, SurfaceResult& r) {
+void press_stick_surface(StickSurface& sticks, const SurfaceOptions& o, SurfaceResult& r) {
+  // Translation-free (issue 74, item 2): every stage on the sticks' own
+  // box, so a shifted, padded or cropped volume gives the same t, and the
+  // sticks come back on their lattice (the chunked path's blocks too).
+  OwnBox frame;
+  StickSurface surface = on_own_box(std::move(sticks), &frame);
   const PassSet& on = o.passes;
   PressOptions po = o.press;
   FlatOptions fo = o.flat;
@@ -151,6 +156,7 @@ void press_stick_surface(StickSurface& surface, const SurfaceOptions& o, Surface
   if (!on.on(Pass::quadric_fit)) qo.rings = 0;
   r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
   r.pass_times.add(Pass::quadric_fit, r.fit.seconds, r.fit.moved);
+  sticks = off_own_box(std::move(surface), frame);
 }
 
 SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o) {
@@ -167,10 +173,12 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   return smooth_sticks(std::move(surface), o, std::move(r));
 }
 
-SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, SurfaceResult r) {
+SurfaceResult smooth_sticks(StickSurface sticks, const SurfaceOptions& o, SurfaceResult r) {
   const MethodOverrides& ov = o.overrides;
   validate(o);
   const auto t0 = std::chrono::steady_clock::now();
+  StickSurface& surface = sticks;
+  const Lattice lattice = surface.lattice;
   switch (o.method) {
     case Method::pressing: {
       press_stick_surface(surface, o, r);
@@ -180,7 +188,8 @@ SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, Surfa
         SharpenOptions so = o.sharp;
         so.colors = o.color_regions;
         so.passes = on;
-        SharpenResult sr = sharpen(surface, r.flats, so);
+        // On the own box, as the flats' index planes were found.
+        SharpenResult sr = sharpen(on_own_box(std::move(surface)), r.flats, so);
         r.mesh = std::move(sr.mesh);
         r.sharpen = sr.stats;
         r.pass_times.add(sr.stats.passes);
@@ -222,7 +231,7 @@ SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, Surfa
     }
   }
   r.seconds_smooth = seconds_since(t0);
-  simplify_result(surface.lattice, o, r);
+  simplify_result(lattice, o, r);  // the caller's, as Mesh::simplify has it
   return r;
 }
 

@@ -32,7 +32,7 @@ struct Sharpened {
 Sharpened run(const BinaryVolume& volume, const FlatOptions& fo = {}, const PressOptions& po = {},
               const SharpenOptions& so = {}, bool fit = false) {
   Sharpened r;
-  r.surface = extract_sticks(volume);
+  r.surface = on_own_box(extract_sticks(volume));  // as smooth_sticks runs every stage
   press_with_flats(r.surface, build_slice_curves(r.surface), po, &fo, &r.seg);
   if (fit) {
     QuadricFitOptions qo;
@@ -118,49 +118,16 @@ TEST(Sharpen, RotatedBoxesGetTheirEdgesBack) {
   }
 }
 
-using Segments = std::vector<std::array<Vec3, 2>>;
-
-Segments labelled_edges(const Mesh& m) {
-  Segments e;
-  for (const auto& ed : m.edges) e.push_back({m.positions[ed[0]], m.positions[ed[1]]});
-  return e;
-}
-
-// Distances from points every quarter cell along `from` to the nearest
-// segment of `to` (infinite when `to` is empty; one infinite distance when
-// `from` is), sorted.
-std::vector<double> sampled_distances(const Segments& from, const Segments& to) {
-  std::vector<double> d;
-  for (const auto& sg : from) {
-    const int k = std::max(1, int(std::ceil((sg[1] - sg[0]).norm() / 0.25)));
-    for (int i = 0; i <= k; ++i) {
-      const Vec3 p = sg[0] + (sg[1] - sg[0]) * (double(i) / k);
-      d.push_back(to.empty() ? INFINITY : (closest_on_segments(p, to) - p).norm());
-    }
-  }
-  if (d.empty()) d.push_back(INFINITY);
-  std::sort(d.begin(), d.end());
-  return d;
-}
-
-// True sharp curves to the labelled edges of m, and back.
-std::vector<double> crease_distances(const Segments& truth, const Mesh& m) { return sampled_distances(truth, labelled_edges(m)); }
-std::vector<double> labelled_distances(const Segments& truth, const Mesh& m) { return sampled_distances(labelled_edges(m), truth); }
-
 TEST(Sharpen, CadPartErrorDropsAndItsCreasesAreFound) {
   // Sharpened as `voxpress press` does it (the quadric fit included), the
-  // CAD part is closer to the truth in position and normal,
-  // and its labelled creases and the true ones lie near each other both
-  // ways. Each rotation here had a spot where a vertex beside two flats
-  // sent the labels astray (two-sided Hausdorff, voxels, measured before ->
-  // after): seed 3, a fillet tangent to one flat met the other at a crease
-  // but was judged against the tangent flat alone, and the crease had a gap
-  // (0.72 -> 0.34); seed 10, a curved junction at a sample, whose stick lies
-  // wholly below the curved side's plane, stayed curved and the chain
-  // detoured round it (0.85 -> 0.62, the rest another corner); seed 128, a
-  // corner without a curved plane stayed at its centroid, a spur off the
-  // crease of two flats (0.67 -> 0.42).
-  for (const auto& [seed, most] : std::map<int, double>{{3, 0.5}, {10, 0.75}, {128, 0.55}}) {
+  // CAD part is closer to the truth in position and normal, and its
+  // labelled creases and the true ones lie near each other both ways. Each
+  // rotation here once had a spot where a vertex beside two flats sent the
+  // labels astray: seed 3, a fillet tangent to one flat met the other at a
+  // crease but was judged against the tangent flat alone; seed 10, a curved
+  // junction at a sample stayed curved and the chain detoured round it;
+  // seed 128, a corner without a curved plane stayed at its centroid.
+  for (const int seed : {3, 10, 128}) {
     SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
     const GeneratedShape g = shape(ShapeKind::cad_part, 128, seed);
     const Sharpened r = run(g.volume, {}, {}, {}, true);
@@ -169,9 +136,14 @@ TEST(Sharpen, CadPartErrorDropsAndItsCreasesAreFound) {
     const EvalReport before = eval(r.before, *t, g.volume), after = eval(r.after, *t, g.volume);
     EXPECT_LT(after.result_to_truth_vox.rms, before.result_to_truth_vox.rms);
     EXPECT_LT(after.normal_error_deg, before.normal_error_deg);
-    const auto sharp = t->sharp_edges(30);
-    const double h = std::max(crease_distances(sharp, r.after).back(), labelled_distances(sharp, r.after).back());
-    EXPECT_LT(h, most) << "measured 0.34, 0.62, 0.42";
+    // How much of the crease network is found, and how much of what is
+    // labelled is real (within half a voxel). One worst point (the two-sided
+    // Hausdorff) is a lottery over where the lattice falls: over seeds 3, 10
+    // and 128 each generated with margins 2-7 (18 samplings) it ranged
+    // 0.22-18.7 voxels, recall 97.4-100 % and precision 98.0-100 %.
+    ASSERT_TRUE(after.sharp_recall && after.sharp_precision);
+    EXPECT_GE(*after.sharp_recall, 0.97);
+    EXPECT_GE(*after.sharp_precision, 0.97);
   }
 }
 
@@ -444,12 +416,14 @@ TEST(Sharpen, FandiskGetsMoreAccurate) {
   const EvalReport before = eval(r.before, *v.truth, v.volume), after = eval(r.after, *v.truth, v.volume);
   EXPECT_LT(after.result_to_truth_vox.rms, before.result_to_truth_vox.rms);
   EXPECT_GT(r.after.edges.size(), 0u);
-  // The crease between a thin wall and a curved face is labelled: with the
-  // wall's vertices left out of the curved crease fit's sides it was not,
-  // and the true sharp curves were 8.9 voxels from a label there (5.9 now,
-  // at a 30-33 degree crease elsewhere).
-  ASSERT_TRUE(after.sharp_true_to_labelled_vox.has_value());
-  EXPECT_LT(*after.sharp_true_to_labelled_vox, 7.0);
+  // Most of the crease network is found (the crease between a thin wall
+  // and a curved face was not while the wall's vertices were in the curved
+  // crease fit's sides), and what is labelled is real. Over voxelizations
+  // with margins 2-7 (six samplings) recall was 91.7-94.9 % and precision
+  // 94.8-97.4 %; the largest gap, one point, 4.1-18.1 voxels.
+  ASSERT_TRUE(after.sharp_recall && after.sharp_precision);
+  EXPECT_GE(*after.sharp_recall, 0.90);
+  EXPECT_GE(*after.sharp_precision, 0.94);
 }
 
 }  // namespace

@@ -73,6 +73,24 @@ struct ExtractStats {
 StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& options = {},
                             ExtractStats* stats = nullptr);
 
+/// Where on_own_box moved a surface from.
+struct OwnBox {
+  Lattice lattice;              ///< the sticks' lattice before
+  std::array<int64_t, 3> lo{};  ///< the box's first sample on it
+};
+
+/// The same sticks (same order, same t) on the lattice of their own box: the
+/// box of their lower samples, upper samples included, its origin at the
+/// box's first sample. Physical positions are unchanged, index positions are
+/// relative to the box, so a shifted, padded or cropped volume gives the
+/// same index arithmetic (smooth_sticks runs every stage on it). Every
+/// inside sample lies in the box (each is enclosed by sticks along every
+/// axis), so the samples beyond it are outside, as the padding assumes.
+/// `frame`, if given, receives what off_own_box needs to undo it.
+StickSurface on_own_box(StickSurface surface, OwnBox* frame = nullptr);
+/// The same sticks (same order, same t) back on the lattice on_own_box left.
+StickSurface off_own_box(StickSurface surface, const OwnBox& frame);
+
 /// Global key of a stick of a volume of `dims` samples: its lower sample
 /// (p, q, r) in padded index space (unpadded + 1) and axis a, ordered as
 /// extract_sticks orders sticks: ((r * (ny + 2) + q) * 3 + a) * (nx + 2) + p.
