@@ -28,6 +28,18 @@ double float32_clearance(const Lattice& lattice, double reach) {
   return std::max(4 * rounding, 1e-12);
 }
 
+double float32_clearance_around(const Lattice& lattice, const std::vector<Vec3>& index_points, double reach) {
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
+  if (!index_points.empty()) {
+    lo = hi = index_points[0];
+    for (const Vec3& x : index_points) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  }
+  Lattice box = lattice;
+  box.origin = lattice.to_physical(Vec3(lo.array().floor()));
+  for (size_t a = 0; a < 3; ++a) box.dims[a] = int64_t(std::floor(hi[int(a)]) - std::floor(lo[int(a)])) + 2;
+  return float32_clearance(box, reach);
+}
+
 double float32_rounding(const Lattice& lattice, double reach) {
   constexpr double kHalfUlp = 0x1p-24;
   const Mat3 M = lattice.index_to_physical_matrix();

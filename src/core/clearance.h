@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "voxpress/core/lattice.h"
 #include "voxpress/core/types.h"
@@ -25,6 +26,12 @@ namespace voxpress::detail {
 /// box (the padding ring and sharpened vertices lie within 2 cells). 4x: the
 /// two sides of a distance each move by the rounding, and a factor 2 spare.
 double float32_clearance(const Lattice& lattice, double reach = 2);
+
+/// float32_clearance for points within `reach` cells of the box of
+/// `index_points` (a mesh's vertices) instead of the lattice's: the same for
+/// a shifted, padded or cropped volume, and no larger for a small surface in
+/// a large volume.
+double float32_clearance_around(const Lattice& lattice, const std::vector<Vec3>& index_points, double reach = 2);
 
 /// Index-space cells: the largest move float32 rounding of the physical
 /// positions can cause for points of `lattice` within `reach` cells of its

@@ -83,7 +83,7 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
                      cubes.vertex_groups.begin() + cubes.vertex_offsets[v + 1]);
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  const double delta = detail::float32_clearance(s.lattice);
+  const double delta = detail::float32_clearance_around(s.lattice, x);
   st.cubes_put_back = detail::put_back(s.mesh, cubes, detail::failing_cubes(s.mesh, cubes, touched, x, delta), x,
                                        back, reset, delta);
   tbb::parallel_for(size_t(0), n, [&](size_t v) {

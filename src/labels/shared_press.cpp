@@ -497,7 +497,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
     plane_family(s, a, edges, barrier, jg, x0, M, o, families[size_t(a)], ids[a], offsets[a], st);
 
   const Cubes cubes = detail::cubes_of(s.mesh, x0);
-  const double delta = detail::float32_clearance(s.lattice);
+  const double delta = detail::float32_clearance_around(s.lattice, x0);
   std::vector<uint32_t> all(cubes.offsets.size() - 1);
   for (uint32_t g = 0; g < all.size(); ++g) all[g] = g;
   std::vector<Vec3> place;

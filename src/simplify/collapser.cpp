@@ -102,14 +102,10 @@ void Collapser::build() {
     // 74, item 2): the clearance covers the rounding of the coordinates
     // the mesh has (and 2 cells around), and every lattice point is a
     // sample (beyond the volume, outside ones), keyed from the box's corner.
-    Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-    for (const Vec3& x : xi) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-    if (nv == 0) lo = hi = Vec3::Zero();
+    Vec3 lo = nv ? xi[0] : Vec3::Zero();
+    for (const Vec3& x : xi) lo = lo.cwiseMin(x);
     key_base = lo.array().floor() - double(kKeyRoom);
-    Lattice box = *o.lattice;
-    box.origin = o.lattice->to_physical(lo.array().floor().matrix());
-    for (size_t a = 0; a < 3; ++a) box.dims[a] = int64_t(std::floor(hi[int(a)]) - std::floor(lo[int(a)])) + 2;
-    delta = float32_clearance(box);
+    delta = float32_clearance_around(*o.lattice, xi);
   } else {
     delta = 4 * std::ldexp(std::max(reach, 1.0), -24);  // float32 rounding of the largest coordinate, 4x as in clearance.h
   }
