@@ -290,14 +290,27 @@ std::map<double, std::string> read_label_names(const std::string& path) {
 
 namespace {
 
-// The label's box grown by one sample, clipped to the lattice (inclusive).
-std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> mask_box(const Lattice& lattice, const LabelInfo& label) {
+// The label's box grown by one sample (inclusive), not clipped to the
+// lattice: beyond it the mask is background, as everywhere outside a
+// volume. So a label's mask, and every stage run on it, is the same for a
+// cropped, shifted or padded map (issue 74, item 2).
+std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> mask_box(const LabelInfo& label) {
   std::array<int64_t, 3> lo{}, hi{};
   for (size_t a = 0; a < 3; ++a) {
-    lo[a] = std::max<int64_t>(0, label.lo[a] - 1);
-    hi[a] = std::min<int64_t>(lattice.dims[a] - 1, label.hi[a] + 1);
+    lo[a] = label.lo[a] - 1;
+    hi[a] = label.hi[a] + 1;
   }
   return {lo, hi};
+}
+
+// The part of [lo, hi] (inclusive) inside the lattice, as a half-open Box.
+Box within(const Lattice& lattice, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
+  Box b;
+  for (size_t a = 0; a < 3; ++a) {
+    b.lo[a] = std::max<int64_t>(0, lo[a]);
+    b.hi[a] = std::min<int64_t>(lattice.dims[a], hi[a] + 1);
+  }
+  return b;
 }
 
 // An empty mask of the box [lo, hi] (mask_box), its lattice's origin at the box's corner.
@@ -312,9 +325,10 @@ BinaryVolume empty_mask(const Lattice& lattice, const std::string& source, const
   return b;
 }
 
-// dst (laid out as `box` of v, x fastest) = whether v's samples in `box`
-// hold the label.
-void mask_into(const ScalarVolume& v, const Box& box, const LabelInfo& label, uint8_t* dst) {
+// The samples of `box` of v that hold the label, into mask m at its sample
+// `at` (box's first sample there).
+void mask_into(const ScalarVolume& v, const Box& box, const LabelInfo& label, BinaryVolume& m,
+               const std::array<int64_t, 3>& at) {
   const uint64_t nc = uint64_t(v.components), layer = uint64_t(label.layer);
   const auto d = box.dims();
   v.visit([&](auto values) {
@@ -324,7 +338,7 @@ void mask_into(const ScalarVolume& v, const Box& box, const LabelInfo& label, ui
       for (int64_t j = 0; j < d[1]; ++j)
         for (int64_t i = 0; i < d[0]; ++i) {
           const uint64_t s = v.lattice.linear(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
-          dst[size_t(i + d[0] * (j + d[1] * k))] = values[size_t(s * nc + layer)] == want;
+          m.inside[m.lattice.linear(at[0] + i, at[1] + j, at[2] + k)] = values[size_t(s * nc + layer)] == want;
         }
     });
   });
@@ -335,9 +349,10 @@ constexpr uint64_t kSlabSamples = uint64_t(1) << 24;  // a box is read this many
 }  // namespace
 
 BinaryVolume label_mask(const ScalarVolume& v, const LabelInfo& label) {
-  const auto [lo, hi] = mask_box(v.lattice, label);
+  const auto [lo, hi] = mask_box(label);
   BinaryVolume b = empty_mask(v.lattice, v.source, lo, hi);
-  mask_into(v, Box{lo, {hi[0] + 1, hi[1] + 1, hi[2] + 1}}, label, b.inside.data());
+  const Box in = within(v.lattice, lo, hi);
+  mask_into(v, in, label, b, {in.lo[0] - lo[0], in.lo[1] - lo[1], in.lo[2] - lo[2]});
   return b;
 }
 
@@ -347,16 +362,17 @@ LabelMasks masks_in(const ScalarVolume& volume) {
 
 LabelMasks masks_read(const Lattice& lattice, const std::string& source, BoxRead read) {
   return [lattice, source, read = std::move(read)](const LabelInfo& label) {
-    const auto [lo, hi] = mask_box(lattice, label);
+    const auto [lo, hi] = mask_box(label);
     BinaryVolume b = empty_mask(lattice, source, lo, hi);
-    const auto& d = b.lattice.dims;
+    const Box in = within(lattice, lo, hi);
+    const auto d = in.dims();
     const int64_t planes = std::max<int64_t>(1, int64_t(kSlabSamples / uint64_t(d[0] * d[1])));
-    for (int64_t k0 = lo[2]; k0 <= hi[2]; k0 += planes) {
-      const int64_t k1 = std::min(hi[2] + 1, k0 + planes);
-      const ScalarVolume slab = read(Box{{lo[0], lo[1], k0}, {hi[0] + 1, hi[1] + 1, k1}});
+    for (int64_t k0 = in.lo[2]; k0 < in.hi[2]; k0 += planes) {
+      const int64_t k1 = std::min(in.hi[2], k0 + planes);
+      const ScalarVolume slab = read(Box{{in.lo[0], in.lo[1], k0}, {in.hi[0], in.hi[1], k1}});
       if (slab.lattice.dims != std::array<int64_t, 3>{d[0], d[1], k1 - k0})
         throw std::logic_error("masks_read: the reader returned the wrong box");
-      mask_into(slab, Box{{0, 0, 0}, slab.lattice.dims}, label, b.inside.data() + size_t(d[0] * d[1] * (k0 - lo[2])));
+      mask_into(slab, Box{{0, 0, 0}, slab.lattice.dims}, label, b, {in.lo[0] - lo[0], in.lo[1] - lo[1], k0 - lo[2]});
     }
     return b;
   };

@@ -42,10 +42,9 @@ class SharedSticks {
 };
 
 /// The lower corner of a label's box with the one sample around it (the
-/// mask label_mask makes), in the shared lattice.
+/// mask label_mask makes, not clipped to the volume), in the shared lattice.
 inline std::array<int64_t, 3> mask_origin(const std::array<int64_t, 3>& label_lo) {
-  return {std::max<int64_t>(0, label_lo[0] - 1), std::max<int64_t>(0, label_lo[1] - 1),
-          std::max<int64_t>(0, label_lo[2] - 1)};
+  return {label_lo[0] - 1, label_lo[1] - 1, label_lo[2] - 1};
 }
 
 }  // namespace voxpress::detail
