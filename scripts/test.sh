@@ -40,8 +40,9 @@ phase "sanitized build done"
 # facts (their code runs in the other Voxelize and VolumeIO tests and the
 # fuzzers); the filleted boxes' decision at 48^3 (39 s under ASan; the
 # round-chains pass runs in the sharpening's corpus) and the invariance
-# checks (74 s: bitwise equality of t, which the press's corpus runs under
-# the sanitizers on the same code). The corpus itself is smaller under the sanitizers
+# checks (74 s, and 70 s for the default pipeline's and the moved origin's:
+# bitwise equality of t and meshes, whose code the corpora run under the
+# sanitizers). The corpus itself is smaller under the sanitizers
 # (tests/test_util.cpp), and the pressing corpus runs one circle correction.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export GTEST_FILTER="-Sharpen.CadPartErrorDropsAndItsCreasesAreFound:Sharpen.RotatedBoxesGetTheirEdgesBack:\
@@ -67,6 +68,7 @@ Pipeline.PressingStagesAndOverridesAreHonoured:Flats.WithoutFlatsTheResultIsTheP
 Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtRandomRotations:\
 VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts:Sharpen.FilletsTheLatticeResolvesStayRound:\
 Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedShapesGiveTheSameT:\
+Invariance.DefaultPipelineOnShiftedPaddedAndCroppedVolumes:Invariance.MovedOriginGivesTheSameT:\
 Simplify.SameBytesForAnyThreadCount"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.
