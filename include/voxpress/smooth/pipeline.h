@@ -108,7 +108,9 @@ void require_float32_room(const Lattice& lattice, const SurfaceOptions& options,
 /// (with flats and junctions when options.passes has them) and the local
 /// quadric fit; fills r.press, r.flats, r.fit, r.pass_times. smooth_surface
 /// runs it, then sharpens; the chunked run (chunk/chunked.h) stitches its
-/// blocks' sticks.
+/// blocks' sticks. Every stage runs on the sticks' own box (on_own_box), so
+/// t does not depend on where the volume lies; r.flats' index planes are in
+/// that box's frame (sharpen them on on_own_box(surface)).
 void press_stick_surface(StickSurface& surface, const SurfaceOptions& options, SurfaceResult& r);
 
 /// The volume's smooth surface by `options.method`. Throws InputError for an
