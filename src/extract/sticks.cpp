@@ -21,9 +21,10 @@
 // the number of threads.
 #include "voxpress/extract/sticks.h"
 
+#include "extract/stick_box.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <chrono>
@@ -159,20 +160,7 @@ StickSurface on_own_box(StickSurface s, OwnBox* frame) {
   const size_t n = s.stick_count();
   if (frame) *frame = {s.lattice, {0, 0, 0}};
   if (n == 0) return s;
-  using Bounds = std::array<int64_t, 6>;  // min, then max, of each coordinate
-  const Bounds box = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, n, 1 << 14), Bounds{INT64_MAX, INT64_MAX, INT64_MAX, INT64_MIN, INT64_MIN, INT64_MIN},
-      [&](const tbb::blocked_range<size_t>& r, Bounds b) {
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-          const auto l = s.lower_index(i);
-          for (size_t a = 0; a < 3; ++a) b[a] = std::min(b[a], l[a]), b[a + 3] = std::max(b[a + 3], l[a]);
-        }
-        return b;
-      },
-      [](Bounds x, const Bounds& y) {
-        for (size_t a = 0; a < 3; ++a) x[a] = std::min(x[a], y[a]), x[a + 3] = std::max(x[a + 3], y[a + 3]);
-        return x;
-      });
+  const detail::IndexBox<3> box = detail::stick_box<3>(n, [&](size_t i) { return s.lower_index(i); });
   Lattice own = s.lattice;
   own.origin = s.lattice.to_physical(Vec3(double(box[0]), double(box[1]), double(box[2])));
   for (size_t a = 0; a < 3; ++a) own.dims[a] = box[a + 3] + 2 - box[a];  // a stick's upper sample lies one past its lower one

@@ -173,11 +173,10 @@ SurfaceResult smooth_surface(const BinaryVolume& volume, const SurfaceOptions& o
   return smooth_sticks(std::move(surface), o, std::move(r));
 }
 
-SurfaceResult smooth_sticks(StickSurface sticks, const SurfaceOptions& o, SurfaceResult r) {
+SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, SurfaceResult r) {
   const MethodOverrides& ov = o.overrides;
   validate(o);
   const auto t0 = std::chrono::steady_clock::now();
-  StickSurface& surface = sticks;
   const Lattice lattice = surface.lattice;
   switch (o.method) {
     case Method::pressing: {
