@@ -69,6 +69,7 @@ Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtR
 VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts:Sharpen.FilletsTheLatticeResolvesStayRound:\
 Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedSphereGivesTheSameT:\
 Invariance.DefaultPipelineOnShiftedPaddedAndCroppedVolumes:Invariance.MovedOriginGivesTheSameT:\
+SharedPress.ShiftedPaddedAndCroppedMapsGiveTheSameSurface:\
 Simplify.SameBytesForAnyThreadCount"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.

@@ -331,6 +331,39 @@ std::vector<uint8_t> flat_places(const SharedSurface& s, const SharedFlats& flat
   return placed;
 }
 
+// The surface's corners relative to its lowest one and its lattice's origin
+// moved there, for the lifetime of the object (the physical positions do
+// not change); the corners and the origin's bits come back after.
+class OwnFrame {
+ public:
+  explicit OwnFrame(SharedSurface& s) : s_(s), origin_(s.lattice.origin) {
+    base_.fill(0);
+    if (!s.corner.empty()) {
+      base_ = s.corner[0];
+      for (const auto& c : s.corner)
+        for (size_t a = 0; a < 3; ++a) base_[a] = std::min(base_[a], c[a]);
+    }
+    shift(-1);
+    s.lattice.origin = s.lattice.to_physical(Vec3(double(base_[0]), double(base_[1]), double(base_[2])));
+  }
+  ~OwnFrame() {
+    shift(1);
+    s_.lattice.origin = origin_;
+  }
+  OwnFrame(const OwnFrame&) = delete;
+  OwnFrame& operator=(const OwnFrame&) = delete;
+
+ private:
+  void shift(int64_t sign) {
+    tbb::parallel_for(size_t(0), s_.corner.size(), [&](size_t v) {
+      for (size_t a = 0; a < 3; ++a) s_.corner[v][a] += sign * base_[a];
+    });
+  }
+  SharedSurface& s_;
+  Vec3 origin_;
+  std::array<int64_t, 3> base_;
+};
+
 // Press levels for the extent of the surface's cells.
 int shared_press_levels(const SharedSurface& s, const PressOptions& o) {
   const size_t n = s.mesh.positions.size();
@@ -459,15 +492,26 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   SharedPressStats st;
   const size_t n = s.mesh.positions.size();
   if (s.kind.size() != n || s.corner.size() != n) throw std::invalid_argument("press_shared: vertex kinds missing");
+  for (uint8_t k : s.kind)
+    if (k > 6) throw std::invalid_argument("press_shared: a sharpened surface (its midpoint places are gone)");
+  if (s.apexes.size() != s.apex_vertices) throw std::invalid_argument("press_shared: apex places missing");
   if (flats && (flats->t.size() != n || flats->region.size() != n || flats->barrier.size() != n))
     throw std::invalid_argument("press_shared: flats of another surface");
-  // Index positions of the midpoint surface; t of the stick vertices.
+  // The press runs on the surface's own box (issue 74, item 2: the same t
+  // for any shift, pad or crop of the map): corners relative to its lowest
+  // one, the origin moved there, and the midpoint places exact in that
+  // frame (no rounding of the physical positions back to index space).
+  const OwnFrame frame(s);
   std::vector<Vec3> x0(n);
   std::vector<double> t0s(n, 0);
   tbb::parallel_for(size_t(0), n, [&](size_t v) {
-    x0[v] = s.lattice.to_index(s.mesh.positions[v]);
-    if (is_stick(s.kind[v])) t0s[v] = x0[v][s.kind[v]] - double(s.corner[v][s.kind[v]]);
+    const uint8_t k = s.kind[v];
+    x0[v] = Vec3(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
+    for (int a = 0; a < 3; ++a)
+      if ((is_stick(k) && k == a) || (is_face(k) && k - 3 != a)) x0[v][a] += 0.5;
+    if (is_stick(k)) t0s[v] = 0.5;
   });
+  for (const auto& [v, place] : s.apexes) x0[v] += place;
   const int levels = shared_press_levels(s, o);
   const std::vector<Edge> edges = edges_of(s.mesh);
 

@@ -120,6 +120,7 @@ void apply(SharedSurface& s, const SharedSurface& base, const std::vector<LabelE
   s.mesh.positions = base.mesh.positions;
   s.kind = base.kind;
   s.corner = base.corner;
+  s.apexes = base.apexes;
   changed.clear();
   const size_t n0 = base.mesh.positions.size(), nt0 = base.mesh.triangles.size();
   owner.assign(n0, {UINT32_MAX, 0});

@@ -44,6 +44,7 @@ SimplifyStats simplify_shared(SharedSurface& s, const SimplifyOptions& options) 
     }
   s.kind.resize(m.positions.size());
   s.corner.resize(m.positions.size());
+  s.apexes.clear();  // the vertices have moved off their midpoint places
   s.mesh = std::move(m);
   return st;
 }

@@ -122,8 +122,7 @@ SharedPiece extract_shared_piece(const ScalarVolume& volume, const Box& read, co
             return keys.key(cube, uint64_t(6 + (v - kApex)));
           };
           for (size_t k = 0; k < lc->apexes.size(); ++k)
-            out.apexes.push_back(
-                {keys.key(cube, 6 + k), Vec3(double(p - 1), double(q - 1), double(r - 1)) + lc->apexes[k]});
+            out.apexes.push_back({keys.key(cube, 6 + k), lc->apexes[k]});
           for (const auto& t : lc->triangles) {
             out.cube.push_back(cube_id);
             out.keys.push_back({vertex_key(t.v[0]), vertex_key(t.v[1]), vertex_key(t.v[2])});
@@ -222,14 +221,18 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
       } else {
         const auto it = std::lower_bound(apex_positions.begin(), apex_positions.end(), all[i],
                                          [](const auto& e, uint64_t k) { return e.first < k; });
-        x = it->second;
+        x += it->second;
       }
       out.mesh.positions[i] = lattice.origin + M * x;
     }
   });
-  for (uint64_t key : all) {
-    const uint64_t kind = keys.decode(key).second;
+  for (uint32_t i = 0; i < all.size(); ++i) {
+    const uint64_t kind = keys.decode(all[i]).second;
     (kind < 3 ? out.stick_vertices : kind < 6 ? out.face_vertices : out.apex_vertices)++;
+    if (kind >= 6)
+      out.apexes.push_back({i, std::lower_bound(apex_positions.begin(), apex_positions.end(), all[i],
+                                                [](const auto& e, uint64_t k) { return e.first < k; })
+                                   ->second});
   }
   // Triangles in cube order, the keys looked up.
   out.mesh.triangles.resize(m);

@@ -38,6 +38,10 @@ struct SharedSurface {
   /// face's or the cube's lowest corner.
   std::vector<uint8_t> kind;
   std::vector<std::array<int64_t, 3>> corner;
+  /// The apex vertices (kind 6) and their exact places in their cubes
+  /// (0..1 from `corner`), by vertex: the shared press starts from them,
+  /// so that its arithmetic does not depend on where the lattice is.
+  std::vector<std::pair<uint32_t, Vec3>> apexes;
   uint64_t stick_vertices = 0, face_vertices = 0, apex_vertices = 0;
 };
 
@@ -57,7 +61,7 @@ struct SharedPiece {
   std::vector<uint64_t> cube;                   ///< per triangle: padded linear index of its cube
   std::vector<std::array<uint64_t, 3>> keys;    ///< per triangle: its vertices' keys
   std::vector<std::array<uint32_t, 2>> values;  ///< per triangle: (in, out) label values
-  std::vector<std::pair<uint64_t, Vec3>> apexes;  ///< key and index-space position of each apex
+  std::vector<std::pair<uint64_t, Vec3>> apexes;  ///< key and place in its cube (0..1) of each apex
   std::string underivable;  ///< the lowest cube without a derived case (empty: none)
   uint64_t underivable_cube = UINT64_MAX;
 };
