@@ -145,15 +145,18 @@ int press_levels_for_extent(int requested, int64_t extent);
 /// fixed points are not circles, so tight curves stay pressed towards the
 /// inner ends of their sticks (a cylinder of radius 4 cells at 128^3: 0.03
 /// voxel inwards, 0.066 RMS). Each fresh vertex (`region` < 0 and no
-/// `junction` flag; empty vectors: every vertex) gets the quadric height
-/// field of the fresh vertices within `rings` rings of it, trusted when its
-/// RMS residual is at most `residual` cells, refitted so that each of those
-/// vertices' stick samples lies at least `stab_eps` cells on its side
-/// (inside below, outside above), and moves to the mean of where its stick
-/// leaves the solids of its own quadric and of its fitted neighbours', t
-/// kept in [margin, 1 - margin] (so, as in pressing, no sample changes
-/// side). All vertices are fitted from the pressed positions
-/// (Jacobi: the result does not depend on the order or the thread count).
+/// `junction` flag; empty vectors: every vertex) is a site or next to one
+/// (sites chosen by priorities that only each vertex's neighbourhood
+/// decides, so neither the lattice's placement nor the stick order does).
+/// Each site gets the quadric height field of the fresh vertices within
+/// `rings` rings of it, trusted when its RMS residual is at most `residual`
+/// cells, refitted so that each of those vertices' stick samples lies at
+/// least `stab_eps` cells on its side (inside below, outside above); each
+/// fresh vertex moves to the mean of where its stick leaves the solids of
+/// the trusted sites' quadrics within two rings, t kept in [margin, 1 -
+/// margin] (so, as in pressing, no sample changes side). All vertices are
+/// fitted from the pressed positions (Jacobi: the result does not depend on
+/// the order or the thread count).
 /// Measured: the `quadric-fit` row of build/bench/bench_ablation
 /// (docs/BENCHMARKS.md, Ablation).
 struct QuadricFitOptions {
@@ -164,13 +167,13 @@ struct QuadricFitOptions {
 };
 
 struct QuadricFitStats {
-  size_t fitted = 0;  ///< vertices whose fit was trusted
+  size_t fitted = 0;  ///< vertices with a trusted quadric around
   size_t moved = 0;   ///< of those, vertices that moved
   double seconds = 0;
 };
 
-/// `only` (optional, per stick): the vertices that may move; only their
-/// quadrics and their neighbours' are fitted (a label's part of a shared
+/// `only` (optional, per stick): the vertices that may move; only the
+/// sites they read are fitted (a label's part of a shared
 /// surface, shared_fit.h). The result is the same for them as without.
 QuadricFitStats fit_local_quadrics(StickSurface& surface, const std::vector<int32_t>& region,
                                    const std::vector<uint8_t>& junction, const QuadricFitOptions& options = {},
