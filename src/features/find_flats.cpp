@@ -44,6 +44,57 @@ size_t FlatSegmentation::frozen_count() const {
 
 namespace flats_impl {
 
+bool Detector::accept(const std::vector<uint32_t>& core, const Plane& P) const {
+  if (area_of(core) < o.min_area) return false;
+  // Spread of the normals about the plane's, robust to the rounded rims:
+  // the median angle. A strip where a plane is tangent to a curved surface
+  // is *defined* by the cone, so its normals fill it (median ~ cone / 2 at
+  // any resolution, whether the strip is straight or a torus's ring); a
+  // face's sit near the plane's normal. (Measured: strips 1.4-2.5 deg,
+  // faces 0.2-1.25 deg with the default 3 deg cone.)
+  std::vector<double> spread(core.size());
+  for (size_t q = 0; q < core.size(); ++q) spread[q] = std::acos(std::clamp(S.nrm[core[q]].dot(P.n), -1.0, 1.0));
+  std::nth_element(spread.begin(), spread.begin() + ptrdiff_t(spread.size() / 2), spread.end());
+  // At 64^3 the estimate of a box is a pillow and its smaller faces spread
+  // up to 1.8 deg: they are missed (docs/BENCHMARKS.md).
+  if (spread[spread.size() / 2] > detail::kFlatMaxSpread * kPi / 180) return false;
+  Vec3 u, v;
+  frame(P.n, u, v);
+  // In-plane coordinates, centred.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (uint32_t q : core) mean += Eigen::Vector2d(S.x[q].dot(u), S.x[q].dot(v));
+  mean /= double(core.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  // Normal bend: tangential normal components regressed on position,
+  // (nu, nv) = A + B (pu, pv); B's largest singular value is a curvature.
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
+  for (uint32_t q : core) {
+    const Eigen::Vector2d p = Eigen::Vector2d(S.x[q].dot(u), S.x[q].dot(v)) - mean;
+    cov += p * p.transpose();
+    const Eigen::Vector3d a(1, p.x(), p.y());
+    ata += a * a.transpose();
+    atb += a * Eigen::RowVector2d(S.nrm[q].dot(u), S.nrm[q].dot(v));
+  }
+  cov /= double(core.size());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> pe(cov);
+  if (std::sqrt(12 * std::max(0.0, pe.eigenvalues()(0))) < min_width(o)) return false;
+  const Eigen::Matrix<double, 3, 2> coef = ata.ldlt().solve(atb);
+  Eigen::Matrix2d B = coef.bottomRows<2>().transpose();  // rows: nu, nv; columns: d/dpu, d/dpv
+  const Eigen::Matrix2d sym = 0.5 * (B + B.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> be(sym);
+  const int big = std::abs(be.eigenvalues()(0)) > std::abs(be.eigenvalues()(1)) ? 0 : 1;
+  const double kappa = std::abs(be.eigenvalues()(big));
+  const Eigen::Vector2d dir = be.eigenvectors().col(big);
+  double lo = 1e300, hi = -1e300;
+  for (uint32_t q : core) {
+    const double s = Eigen::Vector2d(S.x[q].dot(u), S.x[q].dot(v)).dot(dir);
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+  }
+  return kappa * (hi - lo) <= detail::kFlatMaxBend * kPi / 180;
+}
+
 FlatsContext::FlatsContext(const StickSurface& surface, const std::vector<double>& estimate, const FlatOptions& options,
                            FlatSegmentation& out)
     : s(surface),

@@ -22,6 +22,63 @@
 
 namespace voxpress::flats_impl {
 
+class MinNorm {
+ public:
+  MinNorm(const std::vector<Eigen::Vector3d>& a, const std::vector<double>& b) : a_(a), b_(b), order_(a.size()) {
+    // A fixed pseudo-random order: deterministic results.
+    std::vector<std::pair<uint64_t, uint32_t>> key(a.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      uint64_t z = i + 0x9E3779B97F4A7C15ull;
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+      key[i] = {z ^ (z >> 31), uint32_t(i)};
+    }
+    std::sort(key.begin(), key.end());
+    for (size_t i = 0; i < a.size(); ++i) order_[i] = key[i].second;
+  }
+  bool solve(Eigen::Vector3d& w) {
+    int E[3];
+    return solve(order_.size(), E, 0, w);
+  }
+
+ private:
+  // The point of {a_e . w = b_e, e in E} nearest the origin.
+  bool project(const int* E, int k, Eigen::Vector3d& w) const {
+    if (k == 0) {
+      w.setZero();
+      return true;
+    }
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (int q = 0; q < k; ++q) {
+      A.col(q) = a_[size_t(E[q])];
+      rhs(q) = b_[size_t(E[q])];
+    }
+    const Eigen::MatrixXd Ak = A.leftCols(k);
+    const Eigen::MatrixXd G = Ak.transpose() * Ak;
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(G);
+    lu.setThreshold(1e-12);
+    if (lu.rank() < k) return false;
+    w = Ak * lu.solve(rhs.head(k));
+    return true;
+  }
+  bool solve(size_t count, int* E, int k, Eigen::Vector3d& w) {
+    if (!project(E, k, w)) return false;
+    for (size_t q = 0; q < count; ++q) {
+      const uint32_t i = order_[q];
+      if (a_[i].dot(w) >= b_[i] - 1e-12 * (1 + std::abs(b_[i]))) continue;
+      if (k == 3) return false;  // only rounding can get here
+      E[k] = int(i);
+      if (!solve(q, E, k + 1, w)) return false;
+    }
+    return true;
+  }
+  const std::vector<Eigen::Vector3d>& a_;
+  const std::vector<double>& b_;
+  std::vector<uint32_t> order_;
+};
+
+
 // ---------------------------------------------------------------- directions
 // Equal-angle cube map: face (axis a, sign), the two other coordinates
 // divided by |d_a| and mapped through atan, so cells span equal angles along

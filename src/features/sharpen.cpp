@@ -150,6 +150,24 @@ Mesh Sharpener::output() const {
   return m;
 }
 
+Vec3 solve_planes(const Plane* planes, int count, const Vec3& x0, double floor) {
+  Mat3 A = Mat3::Zero();
+  Vec3 r = Vec3::Zero();
+  for (int i = 0; i < count; ++i) {
+    A += planes[i].n * planes[i].n.transpose();
+    r += planes[i].n * (planes[i].c - planes[i].n.dot(x0));
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> es(A);
+  Vec3 dx = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const double l = es.eigenvalues()[k];
+    if (l < floor) continue;
+    const Vec3 e = es.eigenvectors().col(k);
+    dx += e * (e.dot(r) / l);
+  }
+  return x0 + dx;
+}
+
 }  // namespace voxpress::sharpen_impl
 
 namespace voxpress {

@@ -65,23 +65,7 @@ inline bool in_closed_tet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec
 // eigenvalues below `floor` truncated (those directions keep x0) — the
 // dual-contouring QEF solve. For two planes it is the closest point of their
 // intersection line to x0; for three, their common point.
-inline Vec3 solve_planes(const Plane* planes, int count, const Vec3& x0, double floor) {
-  Mat3 A = Mat3::Zero();
-  Vec3 r = Vec3::Zero();
-  for (int i = 0; i < count; ++i) {
-    A += planes[i].n * planes[i].n.transpose();
-    r += planes[i].n * (planes[i].c - planes[i].n.dot(x0));
-  }
-  Eigen::SelfAdjointEigenSolver<Mat3> es(A);
-  Vec3 dx = Vec3::Zero();
-  for (int k = 0; k < 3; ++k) {
-    const double l = es.eigenvalues()[k];
-    if (l < floor) continue;
-    const Vec3 e = es.eigenvectors().col(k);
-    dx += e * (e.dot(r) / l);
-  }
-  return x0 + dx;
-}
+Vec3 solve_planes(const Plane* planes, int count, const Vec3& x0, double floor);  // features/sharpen.cpp
 
 struct NewVertex {
   uint32_t a = kNone, b = kNone;  // edge vertex: the chamfer edge's ends; corner: kNone

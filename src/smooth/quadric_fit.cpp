@@ -17,6 +17,75 @@
 
 namespace voxpress {
 
+namespace detail {
+
+Pca pca(const std::vector<Vec3>& pts) {
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : pts) mean += p;
+  mean /= double(pts.size());
+  Mat3 cov = Mat3::Zero();
+  for (const Vec3& p : pts) cov += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
+  return {mean, es.eigenvalues(), es.eigenvectors().col(0)};
+}
+
+bool Quadric::fit(const std::vector<Vec3>& pts, const Vec3& outward) {
+  if (pts.size() < 12) return false;
+  const Pca p = pca(pts);
+  set_frame(p.mean, p.normal.dot(outward) < 0 ? Vec3(-p.normal) : p.normal);
+  normal_matrix.setZero();
+  normal_rhs.setZero();
+  heights_squared = 0;
+  Vec6 r;
+  for (const Vec3& x : pts) {
+    const double z = row(x, r);
+    normal_matrix.noalias() += r * r.transpose();
+    normal_rhs += z * r;
+    heights_squared += z * z;
+  }
+  const Eigen::LDLT<Mat6> ldlt(normal_matrix);
+  if (ldlt.info() != Eigen::Success) return false;
+  const Vec6 D = ldlt.vectorD().cwiseAbs();
+  if (!(D.minCoeff() > 1e-12 * D.maxCoeff())) return false;
+  q = ldlt.solve(normal_rhs);
+  residual = rms(pts.size());
+  return true;
+}
+
+void Quadric::stab(const std::vector<Vec3>& pts, const std::vector<Vec3>& ins, const std::vector<Vec3>& outs, double eps,
+                 double weight, int iters) {
+  // Each sample's design row and target, once (2k: inside, 2k + 1: outside).
+  thread_local std::vector<Vec6> rs;
+  thread_local std::vector<double> zs;
+  thread_local std::vector<uint8_t> active;
+  rs.resize(2 * ins.size());
+  zs.resize(2 * ins.size());
+  active.assign(2 * ins.size(), 0);
+  for (size_t k = 0; k < ins.size(); ++k) {
+    zs[2 * k] = row(ins[k], rs[2 * k]);
+    zs[2 * k + 1] = row(outs[k], rs[2 * k + 1]);
+  }
+  Mat6 N = normal_matrix;
+  Vec6 rhs = normal_rhs;
+  for (int it = 0; it < iters; ++it) {
+    bool changed = false;
+    for (size_t k = 0; k < 2 * ins.size(); ++k) {
+      if (active[k]) continue;
+      const double gap = zs[k] - rs[k].dot(q);  // the sample's height over the surface
+      if (k % 2 ? gap >= eps : gap <= -eps) continue;
+      active[k] = 1;
+      changed = true;
+      N.noalias() += weight * rs[k] * rs[k].transpose();
+      rhs += weight * (zs[k] + (k % 2 ? -eps : eps)) * rs[k];
+    }
+    if (!changed) break;
+    q = N.ldlt().solve(rhs);
+  }
+  residual = rms(pts.size());
+}
+
+}  // namespace detail
+
 namespace {
 
 // Quadric::stab's weight. The curved creases use 100; here each vertex has

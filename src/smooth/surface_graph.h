@@ -31,15 +31,7 @@ struct Plane {
 struct Pca {
   Vec3 mean, eigenvalues, normal;
 };
-inline Pca pca(const std::vector<Vec3>& pts) {
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& p : pts) mean += p;
-  mean /= double(pts.size());
-  Mat3 cov = Mat3::Zero();
-  for (const Vec3& p : pts) cov += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Mat3> es(cov);
-  return {mean, es.eigenvalues(), es.eigenvectors().col(0)};
-}
+Pca pca(const std::vector<Vec3>& pts);  // smooth/quadric_fit.cpp
 
 // The least-squares plane of a PCA, oriented along `towards`.
 inline Plane oriented_plane(const Pca& q, const Vec3& towards) {
