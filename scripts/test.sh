@@ -16,7 +16,7 @@ phase "Release suite done"
 [ "${VOXPRESS_NO_SANITIZE:-0}" = 1 ] && exit 0
 
 echo "== the unit and property tests under ASan + UBSan" >&2
-suites=(core_tests extract_tests io_tests eval_tests smooth_tests simplify_tests voxart_tests render_tests)
+suites=(core_tests extract_tests io_tests eval_tests smooth_tests simplify_tests voxart_tests render_tests labels_tests)
 # clang when present (setup installs it): it compiles the sanitized library
 # in half gcc's time.
 compilers=(); command -v clang++ >/dev/null 2>&1 && compilers=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang)
@@ -69,15 +69,28 @@ Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtR
 VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts:Sharpen.FilletsTheLatticeResolvesStayRound:\
 Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedSphereGivesTheSameT:\
 Invariance.DefaultPipelineOnShiftedPaddedAndCroppedVolumes:Invariance.MovedOriginGivesTheSameT:\
-SharedPress.ShiftedPaddedAndCroppedMapsGiveTheSameSurface:\
 Simplify.SameBytesForAnyThreadCount"
+# The label maps' tests run the cases small enough for the sanitizers (each
+# stage of the shared surface: cases, extraction, press, fit, flats and
+# sharpening through press_shared_labels on the phantom, simplification);
+# the 3-label pattern sweep, the adversarial volumes, the assemblies and the
+# 61-label map (40-250 s each under ASan) ran in Release above.
+export LABELS_FILTER="Labels.TableMatchesABruteForceCount:Labels.MaskOnTheBoxIsTheLabelEverywhere:\
+Labels.PhantomEveryLabelKeepsItsSamplesInsideAndTheOthersOut:Labels.LayeredSegmentationEverySegmentOnItsLayer:\
+Labels.BadInputIsRefusedNamingTheFile:LabelCases.TwoLabelsAreTheBinaryCaseWithTheLargerLabelInside:\
+LabelCases.PatternsOfFourToEightLabelsCloseUpOrAreRefused:LabelCases.PatternsRankLabelsByValue:\
+SharedSurface.PhantomLabelsAreClosedAndShareTheirInterfaces:SharedSurface.OneLabelIsTheBinaryMidpointSurface:\
+SharedSurface.SameBytesForAnyThreadCountAndBadInputIsRefused:SharedPress.PressedPhantomKeepsEveryGuarantee:\
+SharedPress.ShiftedPaddedAndCroppedPhantomGivesTheSameSurface:SharedFit.NestedSphereGetsItsBinaryFit:\
+SharedSimplify.PhantomKeepsEveryGuarantee"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.
-runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 io_tests:0:1 extract_tests:0:1
-      simplify_tests:0:1 voxart_tests:0:1 core_tests:0:1 render_tests:0:1)
+runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 labels_tests:0:1 io_tests:0:1
+      extract_tests:0:1 simplify_tests:0:1 voxart_tests:0:1 core_tests:0:1 render_tests:0:1)
 printf '%s\n' "${runs[@]}" | xargs -P "$(nproc)" -I{} sh -c '
   run=$1; t=${run%%:*}; rest=${run#*:}; i=${rest%%:*}; n=${rest#*:}
   log="$0/build-asan/$t.$i.log"
+  [ "$t" = labels_tests ] && export GTEST_FILTER="$LABELS_FILTER"
   GTEST_SHARD_INDEX=$i GTEST_TOTAL_SHARDS=$n "$0/build-asan/tests/$t" --gtest_brief=1 > "$log" 2>&1 &&
     echo "sanitized $t ($((i + 1))/$n): passed" ||
     { echo "sanitized $t ($((i + 1))/$n): FAILED"; tail -40 "$log"; exit 1; }' "$root" {}
