@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <stdexcept>
 #include <sys/resource.h>
 #include <sys/wait.h>
 
@@ -170,6 +171,79 @@ BinaryVolume random_blobs(Rng& rng, std::array<int64_t, 3> d, int blobs) {
           if ((Vec3(double(i), double(j), double(k)) - c).norm() <= r) v.inside[v.lattice.linear(i, j, k)] = 1;
   }
   return v;
+}
+
+namespace {
+
+// The lattice of reframed().
+Lattice reframed_lattice(const Lattice& l, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
+  Lattice out = l;
+  for (size_t a = 0; a < 3; ++a) out.dims[a] = l.dims[a] + lo[a] + hi[a];
+  out.origin = l.to_physical(Vec3(-double(lo[0]), -double(lo[1]), -double(lo[2])));
+  return out;
+}
+
+// For each sample of `out` (reframed_lattice(l, lo, ...)) within `l`:
+// put(its linear index in out, get(its linear index in l)).
+template <class Get, class Put>
+void copy_reframed(const Lattice& l, const Lattice& out, const std::array<int64_t, 3>& lo, Get get, Put put) {
+  for (int64_t k = 0; k < out.dims[2]; ++k)
+    for (int64_t j = 0; j < out.dims[1]; ++j)
+      for (int64_t i = 0; i < out.dims[0]; ++i) {
+        const int64_t x = i - lo[0], y = j - lo[1], z = k - lo[2];
+        if (x >= 0 && y >= 0 && z >= 0 && x < l.dims[0] && y < l.dims[1] && z < l.dims[2])
+          put(out.linear(i, j, k), get(l.linear(x, y, z)));
+      }
+}
+
+// lo, hi of reframed() that crop to the box of the samples where `in` holds.
+template <class In>
+std::array<std::array<int64_t, 3>, 2> crop_of(const Lattice& l, In in) {
+  std::array<int64_t, 3> mn{INT64_MAX, INT64_MAX, INT64_MAX}, mx{-1, -1, -1};
+  for (int64_t k = 0; k < l.dims[2]; ++k)
+    for (int64_t j = 0; j < l.dims[1]; ++j)
+      for (int64_t i = 0; i < l.dims[0]; ++i)
+        if (in(l.linear(i, j, k))) {
+          const std::array<int64_t, 3> x{i, j, k};
+          for (size_t a = 0; a < 3; ++a) mn[a] = std::min(mn[a], x[a]), mx[a] = std::max(mx[a], x[a]);
+        }
+  return {{{-mn[0], -mn[1], -mn[2]}, {mx[0] + 1 - l.dims[0], mx[1] + 1 - l.dims[1], mx[2] + 1 - l.dims[2]}}};
+}
+
+}  // namespace
+
+BinaryVolume reframed(const BinaryVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
+  BinaryVolume p;
+  p.source = v.source;
+  p.lattice = reframed_lattice(v.lattice, lo, hi);
+  p.inside.assign(p.lattice.size(), 0);
+  copy_reframed(v.lattice, p.lattice, lo, [&](uint64_t n) { return v.inside[n]; },
+                [&](uint64_t n, uint8_t x) { p.inside[n] = x; });
+  return p;
+}
+
+ScalarVolume reframed(const ScalarVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
+  ScalarVolume p;
+  p.source = v.source;
+  p.type = ScalarType::u8;
+  p.lattice = reframed_lattice(v.lattice, lo, hi);
+  p.bytes.assign(p.lattice.size(), std::byte{0});
+  copy_reframed(v.lattice, p.lattice, lo, [&](uint64_t n) { return v.value(n * uint64_t(v.components)); },
+                [&](uint64_t n, double x) {
+                  if (!(x >= 0 && x < 256)) throw std::invalid_argument("reframed: a value beyond 0..255");
+                  p.bytes[n] = std::byte(uint8_t(x));
+                });
+  return p;
+}
+
+BinaryVolume cropped(const BinaryVolume& v) {
+  const auto [lo, hi] = crop_of(v.lattice, [&](uint64_t n) { return v.inside[n] != 0; });
+  return reframed(v, lo, hi);
+}
+
+ScalarVolume cropped(const ScalarVolume& v) {
+  const auto [lo, hi] = crop_of(v.lattice, [&](uint64_t n) { return v.value(n * uint64_t(v.components)) != 0; });
+  return reframed(v, lo, hi);
 }
 
 BinaryVolume checkerboard(std::array<int64_t, 3> d, int period_axes) {

@@ -97,6 +97,16 @@ BinaryVolume random_blobs(Rng& rng, std::array<int64_t, 3> dims, int blobs);
 /// Inside where (i + j + k) % 2 == 0 (every neighbour pair differs).
 BinaryVolume checkerboard(std::array<int64_t, 3> dims, int period_axes = 7);
 
+/// The volume with `lo` samples added before and `hi` after each axis
+/// (negative: removed), its origin moved so that every sample stays where it
+/// is; new samples are outside (background). A scalar volume comes back as
+/// u8, one component (values 0..255).
+BinaryVolume reframed(const BinaryVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi);
+ScalarVolume reframed(const ScalarVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi);
+/// The volume cropped to the box of its inside (non-zero) samples.
+BinaryVolume cropped(const BinaryVolume& v);
+ScalarVolume cropped(const ScalarVolume& v);
+
 /// A named volume for property tests.
 struct Case {
   std::string name;

@@ -206,35 +206,8 @@ TEST(SharedPress, SameBytesForOneAndManyThreads) {
 // (flats, press, fit, sharpening): the same triangles, their labels, and
 // positions within 1e-9 cell. Three and four labels meet in the phantom
 // (apexes), the assembly has flats and sharp edges.
-ScalarVolume reframed(const ScalarVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
-  ScalarVolume p = v;  // as u8 (labels < 256)
-  p.type = ScalarType::u8;
-  p.components = 1;
-  for (size_t a = 0; a < 3; ++a) p.lattice.dims[a] = v.lattice.dims[a] + lo[a] + hi[a];
-  p.lattice.origin = v.lattice.to_physical(Vec3(-double(lo[0]), -double(lo[1]), -double(lo[2])));
-  p.bytes.assign(p.lattice.size(), std::byte{0});
-  for (int64_t k = 0; k < p.lattice.dims[2]; ++k)
-    for (int64_t j = 0; j < p.lattice.dims[1]; ++j)
-      for (int64_t i = 0; i < p.lattice.dims[0]; ++i) {
-        const int64_t x = i - lo[0], y = j - lo[1], z = k - lo[2];
-        if (x >= 0 && y >= 0 && z >= 0 && x < v.lattice.dims[0] && y < v.lattice.dims[1] && z < v.lattice.dims[2])
-          test::set(p, i, j, k, int(v.value(v.lattice.linear(x, y, z))));
-      }
-  return p;
-}
-
-ScalarVolume cropped(const ScalarVolume& v) {
-  std::array<int64_t, 3> mn{INT64_MAX, INT64_MAX, INT64_MAX}, mx{-1, -1, -1};
-  for (int64_t k = 0; k < v.lattice.dims[2]; ++k)
-    for (int64_t j = 0; j < v.lattice.dims[1]; ++j)
-      for (int64_t i = 0; i < v.lattice.dims[0]; ++i)
-        if (v.value(v.lattice.linear(i, j, k)) != 0) {
-          const std::array<int64_t, 3> x{i, j, k};
-          for (size_t a = 0; a < 3; ++a) mn[a] = std::min(mn[a], x[a]), mx[a] = std::max(mx[a], x[a]);
-        }
-  return reframed(v, {-mn[0], -mn[1], -mn[2]},
-                  {mx[0] + 1 - v.lattice.dims[0], mx[1] + 1 - v.lattice.dims[1], mx[2] + 1 - v.lattice.dims[2]});
-}
+using test::cropped;
+using test::reframed;
 
 void expect_same_surface_when_reframed(const ScalarVolume& v) {
   const SharedLabels ref = press_shared_labels(v, label_table(v), SurfaceOptions{});

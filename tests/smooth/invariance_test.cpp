@@ -11,44 +11,8 @@
 namespace voxpress {
 namespace {
 
-// The volume with `lo` samples added before and `hi` after each axis (all
-// outside), its origin moved back so that the solid stays where it is.
-BinaryVolume padded(const BinaryVolume& v, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
-  BinaryVolume p;
-  p.lattice = v.lattice;
-  for (size_t a = 0; a < 3; ++a) p.lattice.dims[a] = v.lattice.dims[a] + lo[a] + hi[a];
-  p.lattice.origin = v.lattice.to_physical(Vec3(-double(lo[0]), -double(lo[1]), -double(lo[2])));
-  p.inside.assign(p.lattice.size(), 0);
-  for (int64_t k = 0; k < v.lattice.dims[2]; ++k)
-    for (int64_t j = 0; j < v.lattice.dims[1]; ++j)
-      for (int64_t i = 0; i < v.lattice.dims[0]; ++i)
-        p.inside[p.lattice.linear(i + lo[0], j + lo[1], k + lo[2])] = v.inside[v.lattice.linear(i, j, k)];
-  p.source = v.source;
-  return p;
-}
-
-// The volume cropped to the box of its inside samples (negative padding).
-BinaryVolume cropped(const BinaryVolume& v) {
-  std::array<int64_t, 3> mn{INT64_MAX, INT64_MAX, INT64_MAX}, mx{-1, -1, -1};
-  for (int64_t k = 0; k < v.lattice.dims[2]; ++k)
-    for (int64_t j = 0; j < v.lattice.dims[1]; ++j)
-      for (int64_t i = 0; i < v.lattice.dims[0]; ++i)
-        if (v.inside[v.lattice.linear(i, j, k)]) {
-          const std::array<int64_t, 3> x{i, j, k};
-          for (size_t a = 0; a < 3; ++a) mn[a] = std::min(mn[a], x[a]), mx[a] = std::max(mx[a], x[a]);
-        }
-  BinaryVolume c;
-  c.lattice = v.lattice;
-  for (size_t a = 0; a < 3; ++a) c.lattice.dims[a] = mx[a] + 1 - mn[a];
-  c.lattice.origin = v.lattice.to_physical(Vec3(double(mn[0]), double(mn[1]), double(mn[2])));
-  c.inside.assign(c.lattice.size(), 0);
-  for (int64_t k = 0; k < c.lattice.dims[2]; ++k)
-    for (int64_t j = 0; j < c.lattice.dims[1]; ++j)
-      for (int64_t i = 0; i < c.lattice.dims[0]; ++i)
-        c.inside[c.lattice.linear(i, j, k)] = v.inside[v.lattice.linear(i + mn[0], j + mn[1], k + mn[2])];
-  c.source = v.source;
-  return c;
-}
+using test::cropped;
+using test::reframed;  // padded by lo before and hi after each axis, the solid where it was
 
 // A generated shape at 48^3, rotated by seed.
 BinaryVolume shape48(ShapeKind kind, int seed) {
@@ -107,7 +71,7 @@ TEST(Invariance, DefaultPipelineOnShiftedPaddedAndCroppedVolumes) {
     SCOPED_TRACE(std::string(shape_name(kind)) + " seed " + std::to_string(seed));
     const BinaryVolume v = shape48(kind, seed);
     SurfaceOptions o;
-    expect_same_surface(v, padded(v, {6, 7, 8}, {5, 5, 5}), o);
+    expect_same_surface(v, reframed(v, {6, 7, 8}, {5, 5, 5}), o);
     o.simplify.faces = 2000;
     expect_same_surface(v, cropped(v), o);
   }
@@ -116,7 +80,7 @@ TEST(Invariance, DefaultPipelineOnShiftedPaddedAndCroppedVolumes) {
 TEST(Invariance, ShiftedAndPaddedRotatedSphereGivesTheSameT) {
   // The stages' t on a curved shape (the CAD part and the box: above).
   const BinaryVolume v = shape48(ShapeKind::sphere, 5);
-  const BinaryVolume p = padded(v, {6, 7, 8}, {5, 5, 5});  // shifted by (1, 2, 3) and padded by 5
+  const BinaryVolume p = reframed(v, {6, 7, 8}, {5, 5, 5});  // shifted by (1, 2, 3) and padded by 5
   SurfaceOptions o;
   expect_same_t(v, p, o);
   expect_same_t(v, cropped(v), o);
@@ -142,7 +106,7 @@ TEST(Invariance, RealMaskShiftedPaddedAndCroppedGivesTheSameT) {
   VOXPRESS_REQUIRE_SHARED_DATA();
   const BinaryVolume v = binarize(read_volume(test::shared_data() + "/medical/totalseg_aorta.nii.gz"));
   SurfaceOptions o;
-  expect_same_t(v, padded(v, {1, 2, 3}, {4, 0, 2}), o);
+  expect_same_t(v, reframed(v, {1, 2, 3}, {4, 0, 2}), o);
   expect_same_t(v, cropped(v), o);
 }
 
