@@ -21,6 +21,7 @@
 #include "core/sentinel.h"
 #include "core/timing.h"
 #include "cube_check.h"
+#include "own_frame.h"
 #include "smooth/curve_kernel.h"
 
 namespace voxpress {
@@ -331,39 +332,6 @@ std::vector<uint8_t> flat_places(const SharedSurface& s, const SharedFlats& flat
   return placed;
 }
 
-// The surface's corners relative to its lowest one and its lattice's origin
-// moved there, for the lifetime of the object (the physical positions do
-// not change); the corners and the origin's bits come back after.
-class OwnFrame {
- public:
-  explicit OwnFrame(SharedSurface& s) : s_(s), origin_(s.lattice.origin) {
-    base_.fill(0);
-    if (!s.corner.empty()) {
-      base_ = s.corner[0];
-      for (const auto& c : s.corner)
-        for (size_t a = 0; a < 3; ++a) base_[a] = std::min(base_[a], c[a]);
-    }
-    shift(-1);
-    s.lattice.origin = s.lattice.to_physical(Vec3(double(base_[0]), double(base_[1]), double(base_[2])));
-  }
-  ~OwnFrame() {
-    shift(1);
-    s_.lattice.origin = origin_;
-  }
-  OwnFrame(const OwnFrame&) = delete;
-  OwnFrame& operator=(const OwnFrame&) = delete;
-
- private:
-  void shift(int64_t sign) {
-    tbb::parallel_for(size_t(0), s_.corner.size(), [&](size_t v) {
-      for (size_t a = 0; a < 3; ++a) s_.corner[v][a] += sign * base_[a];
-    });
-  }
-  SharedSurface& s_;
-  Vec3 origin_;
-  std::array<int64_t, 3> base_;
-};
-
 // Press levels for the extent of the surface's cells.
 int shared_press_levels(const SharedSurface& s, const PressOptions& o) {
   const size_t n = s.mesh.positions.size();
@@ -501,7 +469,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   // for any shift, pad or crop of the map): corners relative to its lowest
   // one, the origin moved there, and the midpoint places exact in that
   // frame (no rounding of the physical positions back to index space).
-  const OwnFrame frame(s);
+  const detail::OwnFrame frame(s);
   std::vector<Vec3> x0(n);
   std::vector<double> t0s(n, 0);
   tbb::parallel_for(size_t(0), n, [&](size_t v) {

@@ -88,7 +88,7 @@ void Quadric::stab(const std::vector<Vec3>& pts, const std::vector<Vec3>& ins, c
 
 namespace {
 
-// Quadric::stab's weight. The curved creases use 100; here each vertex has
+// Quadric::stab's weight. The curved creases use 100; here each site has
 // its own fit, and at 100 the active sets' jumps between neighbouring fits
 // roughen the surface (sphere 128 normal error 0.47 -> 0.75 degrees); 10
 // keeps most of the gain on fandisk and the sphere (measured by
