@@ -196,12 +196,12 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
   // Vertices: the keys in increasing order.
   const std::vector<uint64_t> all = distinct(pieces, &SharedPiece::keys);
   if (all.size() >= UINT32_MAX) throw LimitError(source, "more than 2^32 - 1 vertices");
-  std::vector<std::pair<uint64_t, Vec3>> apex_positions;
+  std::vector<std::pair<uint64_t, Vec3>> apex_places;  // key, place in its cube
   for (SharedPiece& p : pieces) {
-    apex_positions.insert(apex_positions.end(), p.apexes.begin(), p.apexes.end());
+    apex_places.insert(apex_places.end(), p.apexes.begin(), p.apexes.end());
     p.apexes = {};
   }
-  tbb::parallel_sort(apex_positions.begin(), apex_positions.end(),
+  tbb::parallel_sort(apex_places.begin(), apex_places.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
   const Mat3 M = lattice.index_to_physical_matrix();
   out.mesh.positions.resize(all.size());
@@ -213,26 +213,26 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
       Vec3 x(double(s[0] - 1), double(s[1] - 1), double(s[2] - 1));
       out.kind[i] = uint8_t(std::min<uint64_t>(kind, 6));
       out.corner[i] = {s[0] - 1, s[1] - 1, s[2] - 1};
+      if (kind >= 6) continue;  // an apex: placed below, from its place in the cube
       if (kind < 3) {
         x[int(kind)] += 0.5;
-      } else if (kind < 6) {
+      } else {
         for (int a = 0; a < 3; ++a)
           if (a != int(kind - 3)) x[a] += 0.5;
-      } else {
-        const auto it = std::lower_bound(apex_positions.begin(), apex_positions.end(), all[i],
-                                         [](const auto& e, uint64_t k) { return e.first < k; });
-        x += it->second;
       }
       out.mesh.positions[i] = lattice.origin + M * x;
     }
   });
   for (uint32_t i = 0; i < all.size(); ++i) {
-    const uint64_t kind = keys.decode(all[i]).second;
+    const uint8_t kind = out.kind[i];
     (kind < 3 ? out.stick_vertices : kind < 6 ? out.face_vertices : out.apex_vertices)++;
-    if (kind >= 6)
-      out.apexes.push_back({i, std::lower_bound(apex_positions.begin(), apex_positions.end(), all[i],
-                                                [](const auto& e, uint64_t k) { return e.first < k; })
-                                   ->second});
+    if (kind < 6) continue;
+    const Vec3 place = std::lower_bound(apex_places.begin(), apex_places.end(), all[i],
+                                        [](const auto& e, uint64_t k) { return e.first < k; })
+                           ->second;
+    out.apexes.push_back({i, place});
+    const auto& c = out.corner[i];
+    out.mesh.positions[i] = lattice.origin + M * (Vec3(double(c[0]), double(c[1]), double(c[2])) + place);
   }
   // Triangles in cube order, the keys looked up.
   out.mesh.triangles.resize(m);

@@ -133,12 +133,10 @@ void require_float32_room(const Lattice& lattice, const SurfaceOptions& o, const
                              " cells; move the origin closer to the volume)");
 }
 
-void press_stick_surface(StickSurface& sticks, const SurfaceOptions& o, SurfaceResult& r) {
-  // Translation-free (issue 74, item 2): every stage on the sticks' own
-  // box, so a shifted, padded or cropped volume gives the same t, and the
-  // sticks come back on their lattice (the chunked path's blocks too).
-  OwnBox frame;
-  StickSurface surface = on_own_box(std::move(sticks), &frame);
+namespace {
+
+// press_stick_surface's stages on sticks already on their own box.
+void press_on_own_box(StickSurface& surface, const SurfaceOptions& o, SurfaceResult& r) {
   const PassSet& on = o.passes;
   PressOptions po = o.press;
   FlatOptions fo = o.flat;
@@ -156,6 +154,17 @@ void press_stick_surface(StickSurface& sticks, const SurfaceOptions& o, SurfaceR
   if (!on.on(Pass::quadric_fit)) qo.rings = 0;
   r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
   r.pass_times.add(Pass::quadric_fit, r.fit.seconds, r.fit.moved);
+}
+
+}  // namespace
+
+void press_stick_surface(StickSurface& sticks, const SurfaceOptions& o, SurfaceResult& r) {
+  // Translation-free (issue 74, item 2): every stage on the sticks' own
+  // box, so a shifted, padded or cropped volume gives the same t, and the
+  // sticks come back on their lattice (the chunked path's blocks too).
+  OwnBox frame;
+  StickSurface surface = on_own_box(std::move(sticks), &frame);
+  press_on_own_box(surface, o, r);
   sticks = off_own_box(std::move(surface), frame);
 }
 
@@ -180,19 +189,21 @@ SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, Surfa
   const Lattice lattice = surface.lattice;
   switch (o.method) {
     case Method::pressing: {
-      press_stick_surface(surface, o, r);
+      OwnBox frame;  // as press_stick_surface, the sharpening on the same box
+      StickSurface own = on_own_box(std::move(surface), &frame);
+      press_on_own_box(own, o, r);
       const PassSet& on = o.passes;
       const bool features = on.on(Pass::flats);
       if (features && on.on(Pass::sharpen)) {
         SharpenOptions so = o.sharp;
         so.colors = o.color_regions;
         so.passes = on;
-        // On the own box, as the flats' index planes were found.
-        SharpenResult sr = sharpen(on_own_box(std::move(surface)), r.flats, so);
+        SharpenResult sr = sharpen(std::move(own), r.flats, so);
         r.mesh = std::move(sr.mesh);
         r.sharpen = sr.stats;
         r.pass_times.add(sr.stats.passes);
       } else {
+        surface = off_own_box(std::move(own), frame);  // written from the caller's lattice
         r.mesh = to_mesh(surface);
         if (features) add_region_attributes(r.mesh, r.flats, o.color_regions);
       }
