@@ -34,14 +34,17 @@ std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
   return frozen;
 }
 
-// The first estimate's press.
-PressOptions estimate_options(const PressOptions& po) {
+// The first estimate's press: the final press's schedule (its stages by
+// extent, `levels`), so that without flats the estimate is the final press
+// at every size (a 256^3 sphere: one 100-sweep press instead of two). Its
+// sweeps are fixed: the flats do not depend on po.iterations. (With 2
+// stages at every size, as before: the same faces and no spurious flat on
+// the CAD part, boxes and fandisk at 256^3, r->t within 2 %;
+// docs/BENCHMARKS.md, The flats' estimates.)
+PressOptions estimate_options(const PressOptions& po, int levels) {
   PressOptions eo = po;
-  eo.iterations = detail::kEstimateIterations;  // fixed: the flats do not depend on po.iterations
-  // nor on po.levels: the detection's thresholds were tuned on 2 stages (with
-  // 3, a face can gain a piece of a few hundred sticks, degrees off it,
-  // that no plane merges back).
-  eo.levels = 2;
+  eo.iterations = detail::kEstimateIterations;
+  eo.levels = levels;
   eo.tolerance = 0;
   eo.progress = nullptr;
   eo.free_ends = false;  // see PressOptions::free_ends
@@ -65,7 +68,7 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
-  const PressOptions eo = estimate_options(po);
+  const PressOptions eo = estimate_options(po, press_levels(s, po.levels));
   g.first = detail::press_on(g.est, layout, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
@@ -128,7 +131,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const PressStats& first_estimate = g.first;
   const StickSurface& est = g.est;
   const bool est_is_plain = g.plain;
-  const PressOptions eo = estimate_options(po);
+  const PressOptions eo = estimate_options(po, press_levels(s, po.levels));
   apply_flats(s, seg);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
   // by the curved side's fit (fit_creases), and those of creases between
@@ -143,10 +146,11 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   // No flat: the final press would be the estimate again (same start, no
   // frozen vertex, no barrier) when it runs the same schedule and the
   // estimate never came within its tolerance (where it would have stopped).
-  if (seg.flats.empty() && est_is_plain && first.iterations == eo.iterations && press_levels(s, po.levels) == eo.levels &&
+  if (seg.flats.empty() && est_is_plain && first.iterations == eo.iterations &&
       first_estimate.least_residual > po.tolerance) {
     s.t = est.t;
     st.press = first_estimate;
+    st.press.seconds = 0;  // already counted: flats.seconds_estimate
   } else {
     st.press = detail::press_on(s, layout, first, frozen_of(seg), seg.barrier);
   }

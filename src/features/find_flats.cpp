@@ -13,6 +13,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
@@ -30,6 +31,7 @@
 #include <numbers>
 #include <queue>
 #include <tuple>
+#include <unordered_map>
 
 namespace voxpress {
 
@@ -170,13 +172,18 @@ struct Try {
 // rejects ~1,700 cells at 256^3, a CAD part accepts 8 of ~180). A result
 // is used only when no flat was accepted since it was computed; the
 // order of the loop, and so the output, are those of the serial loop.
+// Results are kept until a flat is accepted: a rejected core's unvotes
+// reorder the heap, so a cell tried ahead is often popped a batch later.
 // Tries after an accepted flat are mostly wasted (often the same face
 // from a neighbouring cell), so the look-ahead starts at one cell after
 // each acceptance and doubles with each rejection.
 class Lookahead {
  public:
   Lookahead(const FlatsContext& ctx, const Votes& V)
-      : ctx_(ctx), V_(V), threads_(size_t(tbb::this_task_arena::max_concurrency())), detectors_([&ctx] {
+      : ctx_(ctx), V_(V),
+        threads_(std::min(size_t(tbb::this_task_arena::max_concurrency()),
+                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
+        detectors_([&ctx] {
           return Detector{ctx.S, ctx.o, ctx.seg.region, std::vector<uint32_t>(ctx.n, 0), 0, ctx.cos_cone,
                           std::vector<uint8_t>(ctx.n, 0)};
         }) {}
@@ -184,13 +191,15 @@ class Lookahead {
   // The try of cell c, the first of `heap`'s next cells; `accepted`: the
   // flats accepted so far, `streak`: rejections since the last acceptance.
   const Try& result_of(size_t c, const CellHeap& heap, size_t accepted, size_t streak) {
-    if (tries_version_ == accepted)
-      for (const Try& t : tries_)
-        if (t.cell == c) return t;
+    if (tries_version_ != accepted) {
+      tries_.clear();
+      tries_version_ = accepted;
+    }
+    if (const auto it = tries_.find(c); it != tries_.end()) return it->second;
     const std::vector<size_t> cells = next_cells(c, heap, streak);
-    tries_.assign(cells.size(), Try{});
+    std::vector<Try> batch(cells.size());
     tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
-      Try& t = tries_[k];
+      Try& t = batch[k];
       t.cell = cells[k];
       std::vector<uint32_t> own;
       if (!seeds_of(ctx_, V_, t.cell, own)) return;  // the loop skips it
@@ -201,24 +210,25 @@ class Lookahead {
       t.restabbed = d.restabbed - restabbed;
       t.refused_curved = d.refused_curved - refused;
     });
-    tries_version_ = accepted;
-    return tries_.front();
+    for (Try& t : batch) tries_.emplace(t.cell, std::move(t));
+    return tries_.at(c);
   }
 
  private:
-  // The cells the loop would try after `first` if no flat were accepted.
+  // The cells the loop would try after `first` if no flat were accepted
+  // (those not tried yet).
   std::vector<size_t> next_cells(size_t first, const CellHeap& heap, size_t streak) const {
     const auto& cell_count = V_.cell_count;
     std::vector<size_t> cells{first};
     // Up to 4 per thread: enough to keep every thread busy.
-    const size_t batch = threads_ == 1 ? 1 : std::min(4 * threads_, size_t(1) << std::min<size_t>(streak, 10));
+    const size_t batch = threads_ <= 1 ? 1 : std::min(4 * threads_, size_t(1) << std::min<size_t>(streak, 10));
     if (batch == 1) return cells;
     auto h = heap;
     while (!h.empty() && cells.size() < batch) {
       const auto [cnt, neg] = h.top();
       h.pop();
       const size_t c = size_t(-neg);
-      if (std::find(cells.begin(), cells.end(), c) != cells.end()) continue;
+      if (std::find(cells.begin(), cells.end(), c) != cells.end() || tries_.count(c)) continue;
       if (cnt != cell_count[c]) {
         if (cell_count[c] > 0) h.push({cell_count[c], neg});
         continue;
@@ -232,8 +242,8 @@ class Lookahead {
   const FlatsContext& ctx_;
   const Votes& V_;
   const size_t threads_;
-  std::vector<Try> tries_;
-  size_t tries_version_ = SIZE_MAX;  // `accepted` when tries_ were computed
+  std::unordered_map<size_t, Try> tries_;  // since the last acceptance, by cell
+  size_t tries_version_ = SIZE_MAX;        // `accepted` when tries_ were computed
   tbb::enumerable_thread_specific<Detector> detectors_;
 };
 

@@ -160,7 +160,7 @@ size_t fit_curved_creases(StickSurface& surface, const FlatSegmentation& flats, 
                           std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed = nullptr);
 
 struct FeaturePressStats {
-  PressStats press;
+  PressStats press;  ///< the final press (seconds 0 when it is the first estimate, kept)
   FlatStats flats;
   PassTimes passes;  ///< flats, crease_fit and curved_creases (press time), with their counts
 };
