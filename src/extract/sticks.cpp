@@ -200,50 +200,43 @@ uint64_t count_sticks(const BinaryVolume& volume) {
   return n;
 }
 
-StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& options, ExtractStats* stats) {
-  const auto& dims = volume.lattice.dims;
-  if (volume.inside.size() != volume.lattice.size())
-    throw UsageError("extract_sticks: volume data does not match its lattice");
-  const Padded pv(volume);
-  const int64_t ny2 = pv.rows_y(), nz2 = pv.rows_z(), nx = pv.nx();
-  StickSurface out;
-  out.lattice = volume.lattice;
-  out.padded = {dims[0] + 2, dims[1] + 2, dims[2] + 2};
-  const uint64_t px = uint64_t(out.padded[0]), py = uint64_t(out.padded[1]);
+namespace {
 
-  // ---- Passes 1-2: sticks.
-  auto t0 = std::chrono::steady_clock::now();
-  std::vector<RowInfo> info;
-  {
-    ProgressCounter progress(options.progress, "sticks", uint64_t(nz2));
-    info = classify_rows(pv, options.progress ? &progress : nullptr);
-  }
+// Scan: each row's first stick id; the total.
+uint64_t number_sticks(std::vector<RowInfo>& info) {
   uint64_t total = 0;
   for (RowInfo& r : info) {
     r.offset = total;
     total += uint64_t(r.count[0]) + r.count[1] + r.count[2];
   }
+  return total;
+}
+
+// Refuses (LimitError) a surface of `total` sticks that would not fit the
+// memory limit, with its figures.
+void check_budget(const BinaryVolume& volume, const ExtractOptions& options, uint64_t total) {
   if (total >= std::numeric_limits<uint32_t>::max())
     throw LimitError(volume.source, std::to_string(total) + " sticks exceed the 2^32 - 1 vertex limit of one mesh");
   // Triangles are about twice the vertices (each vertex has ~6 incident
   // triangles, each triangle 3 vertices); 17 bytes per stick, 12 per triangle.
   const uint64_t surface = total * (17 + 2 * 12), later = total * options.later_bytes_per_stick;
   const uint64_t estimate = options.held_bytes + volume.inside.size() + surface + later + kRunBytesFixed;
-  if (options.max_bytes && estimate > options.max_bytes) {
-    const bool small = options.max_bytes < (16u << 20);  // KiB below 16 MiB, so that no figure reads 0
-    auto size = [&](uint64_t b) { return std::to_string(small ? b >> 10 : b >> 20); };
-    const std::string unit = small ? " KiB" : " MiB";
-    throw LimitError(volume.source, "this needs about " + size(estimate) + unit + " (volume " +
-                                        size(volume.inside.size()) + ", surface " + size(surface) +
-                                        ", its smoothing " + size(later) + " for " + std::to_string(total) +
-                                        " sticks, the run " + size(kRunBytesFixed) +
-                                        (options.held_bytes ? ", held before " + size(options.held_bytes) : "") +
-                                        "), above the memory limit of " +
-                                        size(options.max_bytes) + unit);
-  }
-  out.lower.resize(total);
-  out.code.resize(total);
-  out.t.assign(total, 0.5);
+  if (!options.max_bytes || estimate <= options.max_bytes) return;
+  const bool small = options.max_bytes < (16u << 20);  // KiB below 16 MiB, so that no figure reads 0
+  auto size = [&](uint64_t b) { return std::to_string(small ? b >> 10 : b >> 20); };
+  const std::string unit = small ? " KiB" : " MiB";
+  throw LimitError(volume.source, "this needs about " + size(estimate) + unit + " (volume " +
+                                      size(volume.inside.size()) + ", surface " + size(surface) + ", its smoothing " +
+                                      size(later) + " for " + std::to_string(total) + " sticks, the run " +
+                                      size(kRunBytesFixed) +
+                                      (options.held_bytes ? ", held before " + size(options.held_bytes) : "") +
+                                      "), above the memory limit of " + size(options.max_bytes) + unit);
+}
+
+// Pass 2: each row writes its sticks into its own range.
+void fill_sticks(const Padded& pv, const std::vector<RowInfo>& info, StickSurface& out) {
+  const int64_t ny2 = pv.rows_y(), nz2 = pv.rows_z();
+  const uint64_t px = uint64_t(out.padded[0]), py = uint64_t(out.padded[1]);
   parallel_rows(ny2 * nz2, [&](int64_t row) {
     const RowInfo& ri = info[size_t(row)];
     if (ri.last < 0) return;
@@ -264,22 +257,24 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
         }
     }
   });
-  const double seconds_sticks = seconds_since(t0);
+}
 
-  // ---- Passes 3-4: triangles.
-  t0 = std::chrono::steady_clock::now();
-  const int64_t cell_rows_y = dims[1] + 1, cell_rows_z = dims[2] + 1;
-  auto row_index = [&](int64_t q, int64_t r) { return size_t(r * ny2 + q); };
-  struct CellRow {
-    int64_t p0 = 0, p1 = -1;  // cell range to visit
-    uint64_t offset = 0, count = 0;
-  };
-  std::vector<CellRow> cells(size_t(cell_rows_y * cell_rows_z));
+struct CellRow {
+  int64_t p0 = 0, p1 = -1;  // cell range to visit
+  uint64_t offset = 0, count = 0;
+};
+
+// The cell rows (q, r) of the padded volume: each touches the four sample
+// rows (q..q+1, r..r+1).
+class CellRows {
+ public:
+  CellRows(const Padded& pv, const std::vector<RowInfo>& info) : pv_(pv), info_(info) {}
+
   // The 12 edge sets of cell row (q, r): x-sticks of the 4 rows, y-sticks of
-  // rows (q, r), (q, r+1) and z-sticks of rows (q, r), (q+1, r).
-  auto prepare = [&](int64_t q, int64_t r, CellRow& cr) {
-    const RowInfo* R[2][2] = {{&info[row_index(q, r)], &info[row_index(q, r + 1)]},
-                              {&info[row_index(q + 1, r)], &info[row_index(q + 1, r + 1)]}};
+  // rows (q, r), (q, r+1) and z-sticks of rows (q, r), (q+1, r). False when
+  // none holds a stick, else the cell range to visit in cr.
+  bool prepare(int64_t q, int64_t r, CellRow& cr) const {
+    const RowInfo* R[2][2] = {{&at(q, r), &at(q, r + 1)}, {&at(q + 1, r), &at(q + 1, r + 1)}};
     int64_t first = std::numeric_limits<int64_t>::max(), last = -1;
     uint64_t n = 0;
     for (int y = 0; y < 2; ++y)
@@ -291,18 +286,19 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
     n += R[0][0]->count[1] + R[0][1]->count[1] + R[0][0]->count[2] + R[1][0]->count[2];
     if (n == 0) return false;
     cr.p0 = std::max<int64_t>(0, first - 1);
-    cr.p1 = std::min<int64_t>(nx, last);
+    cr.p1 = std::min<int64_t>(pv_.nx(), last);
     return true;
-  };
+  }
+
   // Walks the cells p0..p1 of a cell row. The four sample rows are copied
   // into zero-padded scratch rows, and each x position becomes a nibble
   // col = r00 | r10 << 1 | r01 << 2 | r11 << 3 (bit y + 2 z); a cell's cube
   // case interleaves the nibbles at p and p + 1, and the stick flags the id
-  // counters need are XORs of their bits.
-  const CubeCase* const table = &cube_case(0);
-  auto walk = [&](int64_t q, int64_t r, const CellRow& cr, auto&& visit) {
+  // counters need are XORs of their bits: visit(p, case, col p, col p + 1).
+  template <class Visit>
+  void walk(int64_t q, int64_t r, const CellRow& cr, Visit&& visit) const {
     thread_local std::vector<uint8_t> scratch;
-    const int64_t p0 = cr.p0, p1 = cr.p1;
+    const int64_t p0 = cr.p0, p1 = cr.p1, nx = pv_.nx();
     scratch.assign(size_t(p1 - p0 + 2), 0);
     // Plain locals: uint8_t stores may alias anything, so keep loop bounds
     // and pointers out of memory the compiler would have to reload.
@@ -310,7 +306,7 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
     const int64_t a = std::max<int64_t>(p0, 1), b = std::min<int64_t>(p1 + 1, nx);
     for (int y = 0; y < 2; ++y)
       for (int z = 0; z < 2; ++z)
-        if (const uint8_t* row = pv.row(q + y, r + z)) {
+        if (const uint8_t* row = pv_.row(q + y, r + z)) {
           const int bit = y + 2 * z;
           for (int64_t p = a; p <= b; ++p) cols[p - p0] = uint8_t(cols[p - p0] | (row[p - 1] << bit));
         }
@@ -319,32 +315,48 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
       const unsigned c0 = cols[p - p0], c1 = cols[p - p0 + 1];
       visit(p, spread(c0) | (spread(c1) << 1), c0, c1);
     }
-  };
-  {
-    ProgressCounter progress(options.progress, "triangles", uint64_t(cell_rows_z));
-    tbb::parallel_for(tbb::blocked_range<int64_t>(0, cell_rows_z, 1), [&](const tbb::blocked_range<int64_t>& range) {
-      for (int64_t r = range.begin(); r < range.end(); ++r) {
-        for (int64_t q = 0; q < cell_rows_y; ++q) {
-          CellRow& cr = cells[size_t(r * cell_rows_y + q)];
-          if (!prepare(q, r, cr)) continue;
-          walk(q, r, cr, [&](int64_t, unsigned mask, unsigned, unsigned) { cr.count += table[mask].count; });
-        }
-        progress.add(1);
-      }
-    });
   }
+
+  const RowInfo& at(int64_t q, int64_t r) const { return info_[size_t(r * pv_.rows_y() + q)]; }
+
+ private:
+  const Padded& pv_;
+  const std::vector<RowInfo>& info_;
+};
+
+// Pass 3 and its scan: each cell row's triangle count and first triangle;
+// the total.
+uint64_t count_triangles(const CellRows& rows, int64_t cell_rows_y, int64_t cell_rows_z, std::vector<CellRow>& cells,
+                         const ExtractOptions& options) {
+  const CubeCase* const table = &cube_case(0);
+  ProgressCounter progress(options.progress, "triangles", uint64_t(cell_rows_z));
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, cell_rows_z, 1), [&](const tbb::blocked_range<int64_t>& range) {
+    for (int64_t r = range.begin(); r < range.end(); ++r) {
+      for (int64_t q = 0; q < cell_rows_y; ++q) {
+        CellRow& cr = cells[size_t(r * cell_rows_y + q)];
+        if (!rows.prepare(q, r, cr)) continue;
+        rows.walk(q, r, cr, [&](int64_t, unsigned mask, unsigned, unsigned) { cr.count += table[mask].count; });
+      }
+      progress.add(1);
+    }
+  });
   uint64_t ntri = 0;
   for (CellRow& cr : cells) {
     cr.offset = ntri;
     ntri += cr.count;
   }
-  out.triangles.resize(ntri);
-  parallel_rows(cell_rows_y * cell_rows_z, [&](int64_t idx) {
+  return ntri;
+}
+
+// Pass 4: walk the cells again with one running "next stick id" per (row,
+// axis), writing each cell row's triangles into its range.
+void fill_triangles(const CellRows& rows, int64_t cell_rows_y, const std::vector<CellRow>& cells, StickSurface& out) {
+  const CubeCase* const table = &cube_case(0);
+  parallel_rows(int64_t(cells.size()), [&](int64_t idx) {
     const CellRow& cr = cells[size_t(idx)];
     if (cr.count == 0) return;
     const int64_t q = idx % cell_rows_y, r = idx / cell_rows_y;
-    const RowInfo* R[2][2] = {{&info[row_index(q, r)], &info[row_index(q, r + 1)]},
-                              {&info[row_index(q + 1, r)], &info[row_index(q + 1, r + 1)]}};
+    const RowInfo* R[2][2] = {{&rows.at(q, r), &rows.at(q, r + 1)}, {&rows.at(q + 1, r), &rows.at(q + 1, r + 1)}};
     // Running id of the next stick at or after position p, per (row, axis):
     // x-sticks of the four rows (index y + 2 z), y-sticks of rows z = 0, 1,
     // z-sticks of rows y = 0, 1.
@@ -354,7 +366,7 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
     for (int z = 0; z < 2; ++z) yn[z] = R[0][z]->offset + R[0][z]->count[0];
     for (int y = 0; y < 2; ++y) zn[y] = R[y][0]->offset + R[y][0]->count[0] + R[y][0]->count[1];
     uint64_t w = cr.offset;
-    walk(q, r, cr, [&](int64_t, unsigned mask, unsigned c0, unsigned c1) {
+    rows.walk(q, r, cr, [&](int64_t, unsigned mask, unsigned c0, unsigned c1) {
       const unsigned xs = c0 ^ c1;                     // bit y + 2 z: x-stick at p in row (y, z)
       const unsigned ys = (c0 ^ (c0 >> 1)) & 0b0101u;  // bit 2 z: y-stick at p in row z
       const unsigned zs = (c0 ^ (c0 >> 2)) & 0b0011u;  // bit y: z-stick at p in row y
@@ -381,6 +393,42 @@ StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& op
       zn[1] += (zs >> 1) & 1u;
     });
   });
+}
+
+}  // namespace
+
+StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& options, ExtractStats* stats) {
+  const auto& dims = volume.lattice.dims;
+  if (volume.inside.size() != volume.lattice.size())
+    throw UsageError("extract_sticks: volume data does not match its lattice");
+  const Padded pv(volume);
+  StickSurface out;
+  out.lattice = volume.lattice;
+  out.padded = {dims[0] + 2, dims[1] + 2, dims[2] + 2};
+
+  // ---- Passes 1-2: sticks.
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<RowInfo> info;
+  {
+    ProgressCounter progress(options.progress, "sticks", uint64_t(pv.rows_z()));
+    info = classify_rows(pv, options.progress ? &progress : nullptr);
+  }
+  const uint64_t total = number_sticks(info);
+  check_budget(volume, options, total);
+  out.lower.resize(total);
+  out.code.resize(total);
+  out.t.assign(total, 0.5);
+  fill_sticks(pv, info, out);
+  const double seconds_sticks = seconds_since(t0);
+
+  // ---- Passes 3-4: triangles.
+  t0 = std::chrono::steady_clock::now();
+  const int64_t cell_rows_y = dims[1] + 1, cell_rows_z = dims[2] + 1;
+  const CellRows rows(pv, info);
+  std::vector<CellRow> cells(size_t(cell_rows_y * cell_rows_z));
+  const uint64_t ntri = count_triangles(rows, cell_rows_y, cell_rows_z, cells, options);
+  out.triangles.resize(ntri);
+  fill_triangles(rows, cell_rows_y, cells, out);
   if (stats) {
     stats->samples = volume.lattice.size();
     stats->sticks = total;

@@ -4,51 +4,63 @@
 
 namespace voxpress::sharpen_impl {
 
-void Sharpener::fit_walls() {
-  if (!o.passes.on(Pass::walls)) return;
-  constexpr uint32_t kWallFitRings = 2;
-  constexpr double kResolvedWall = 12;  // cells
-  constexpr double kFlatGap = 0.1;      // cells: a fitted flat's plane may be this far off near its rim
-  const double opposite = std::cos(170 * kPi / 180), kWallLean = std::sin(10 * kPi / 180);
-  // The flats (up to kNear, smallest ids) that reach each fresh vertex over
-  // fresh vertices within wall_thickness + 2 rings, each with the ring it
-  // first arrived at. Jacobi rounds, so the result does not depend on the
-  // visiting order; each round recomputes only the fresh neighbours of the
-  // vertices the last round changed (an organic shape's fresh vertices far
-  // from any flat are never visited).
-  constexpr size_t kNear = 4;
-  struct Reach {
-    int32_t flat = -1, ring = 0;
-    bool operator==(const Reach&) const = default;
-  };
-  using Near = std::array<Reach, kNear>;
-  auto add = [](Near& a, Reach r) {
-    for (Reach& g : a) {
-      if (g.flat == r.flat) {
-        g.ring = std::min(g.ring, r.ring);
-        return;
-      }
-      if (g.flat < 0 || r.flat < g.flat) std::swap(g, r);
-      if (r.flat < 0) return;
+// Candidates of a wall: fresh vertices between two opposite flats, and the
+// pair of flats of each vertex ({-1, -1} for the others).
+struct Walls {
+  std::vector<std::array<int32_t, 2>> pair;
+  std::vector<uint32_t> cand;
+};
+
+namespace {
+
+constexpr uint32_t kWallFitRings = 2;
+constexpr double kResolvedWall = 12;  // cells
+constexpr double kFlatGap = 0.1;      // cells: a fitted flat's plane may be this far off near its rim
+
+// The flats (up to kNear, smallest ids) that reach a fresh vertex, each
+// with the ring it first arrived at.
+constexpr size_t kNear = 4;
+struct Reach {
+  int32_t flat = -1, ring = 0;
+  bool operator==(const Reach&) const = default;
+};
+using Near = std::array<Reach, kNear>;
+void add(Near& a, Reach r) {
+  for (Reach& g : a) {
+    if (g.flat == r.flat) {
+      g.ring = std::min(g.ring, r.ring);
+      return;
     }
-  };
-  std::vector<Near> near(n);
-  std::vector<uint32_t> fresh, changed, todo;
-  for (uint32_t v = 0; v < n; ++v)
-    if (seg.region[v] < 0) {
+    if (g.flat < 0 || r.flat < g.flat) std::swap(g, r);
+    if (r.flat < 0) return;
+  }
+}
+
+// The flats that reach each fresh vertex over fresh vertices within
+// wall_thickness + 2 rings. Jacobi rounds, so the result does not depend on
+// the visiting order; each round recomputes only the fresh neighbours of
+// the vertices the last round changed (an organic shape's fresh vertices
+// far from any flat are never visited).
+std::vector<Near> flats_near(const Sharpener& sh, std::vector<uint32_t>& fresh) {
+  const auto& region = sh.seg.region;
+  const auto &adj_off = sh.adj_off, &adj = sh.adj;
+  std::vector<Near> near(sh.n);
+  std::vector<uint32_t> changed, todo;
+  for (uint32_t v = 0; v < sh.n; ++v)
+    if (region[v] < 0) {
       fresh.push_back(v);
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-        if (seg.region[adj[k]] >= 0) add(near[v], {seg.region[adj[k]], 1});
+        if (region[adj[k]] >= 0) add(near[v], {region[adj[k]], 1});
       if (near[v][0].flat >= 0) changed.push_back(v);
     }
-  std::vector<uint32_t> queued(n, detail::kUnreached);
+  std::vector<uint32_t> queued(sh.n, detail::kUnreached);
   std::vector<Near> next;
   for (uint32_t round = 0; round < uint32_t(std::ceil(detail::kWallThickness)) + 1 && !changed.empty(); ++round) {
     todo.clear();
     for (uint32_t v : changed)
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k) {
         const uint32_t w = adj[k];
-        if (seg.region[w] < 0 && queued[w] != round) {
+        if (region[w] < 0 && queued[w] != round) {
           queued[w] = round;
           todo.push_back(w);
         }
@@ -59,7 +71,7 @@ void Sharpener::fit_walls() {
       const uint32_t v = todo[i];
       next[i] = near[v];
       for (uint32_t k = adj_off[v]; k < adj_off[v + 1]; ++k)
-        if (seg.region[adj[k]] < 0)
+        if (region[adj[k]] < 0)
           for (const Reach& r : near[adj[k]])
             if (r.flat >= 0) add(next[i], {r.flat, r.ring + 1});
     }
@@ -70,15 +82,22 @@ void Sharpener::fit_walls() {
         changed.push_back(todo[i]);
       }
   }
-  std::vector<std::array<int32_t, 2>> pair(n, {-1, -1});
-  std::vector<uint32_t> cand;
+  return near;
+}
+
+// The fresh vertices between the planes of two opposite flats that reach
+// them, across the wall from both.
+Walls wall_candidates(const Sharpener& sh, const std::vector<uint32_t>& fresh, const std::vector<Near>& near) {
+  const double opposite = std::cos(170 * kPi / 180), kWallLean = std::sin(10 * kPi / 180);
+  Walls W;
+  W.pair.assign(sh.n, {-1, -1});
   for (uint32_t v : fresh) {
     const Near& a = near[v];
-    for (size_t i = 0; i < kNear && a[i].flat >= 0 && pair[v][0] < 0; ++i)
+    for (size_t i = 0; i < kNear && a[i].flat >= 0 && W.pair[v][0] < 0; ++i)
       for (size_t j = i + 1; j < kNear && a[j].flat >= 0; ++j) {
-        const Flat &fa = seg.flats[size_t(a[i].flat)], &fb = seg.flats[size_t(a[j].flat)];
-        const double ha = height(a[i].flat, x[v]) / fa.index_normal.norm(),
-                     hb = height(a[j].flat, x[v]) / fb.index_normal.norm(), thickness = -(ha + hb);
+        const Flat &fa = sh.seg.flats[size_t(a[i].flat)], &fb = sh.seg.flats[size_t(a[j].flat)];
+        const double ha = sh.height(a[i].flat, sh.x[v]) / fa.index_normal.norm(),
+                     hb = sh.height(a[j].flat, sh.x[v]) / fb.index_normal.norm(), thickness = -(ha + hb);
         const Vec3 na = fa.index_normal.normalized();
         // Between the two planes, and across the wall from both flats (a
         // rim is crossed in about as many rings as it has cells, plus the
@@ -87,26 +106,34 @@ void Sharpener::fit_walls() {
               thickness <= detail::kWallThickness && std::max(a[i].ring, a[j].ring) <= 1.5 * thickness + 4))
           continue;
         Plane own;
-        if (thickness > kResolvedWall && !(ring_plane(v, own) && std::abs(own.n.normalized().dot(na)) < kWallLean))
+        if (thickness > kResolvedWall && !(sh.ring_plane(v, own) && std::abs(own.n.normalized().dot(na)) < kWallLean))
           continue;
-        pair[v] = {a[i].flat, a[j].flat};
-        cand.push_back(v);
+        W.pair[v] = {a[i].flat, a[j].flat};
+        W.cand.push_back(v);
         break;
       }
   }
-  // An outside sample between A's and B's planes (by more than `gap`
-  // cells) is outside because of the wall, not of a flat.
-  auto between = [&](int32_t A, int32_t B, const Vec3& p, double gap = 0) {
-    return height(A, p) < -gap * seg.flats[size_t(A)].index_normal.norm() &&
-           height(B, p) < -gap * seg.flats[size_t(B)].index_normal.norm();
-  };
-  std::vector<Plane> wall(cand.size());
-  std::vector<uint8_t> ok(cand.size(), 0);
+  return W;
+}
+
+// An outside sample between A's and B's planes (by more than `gap` cells)
+// is outside because of the wall, not of a flat.
+bool between(const Sharpener& sh, int32_t A, int32_t B, const Vec3& p, double gap = 0) {
+  return sh.height(A, p) < -gap * sh.seg.flats[size_t(A)].index_normal.norm() &&
+         sh.height(B, p) < -gap * sh.seg.flats[size_t(B)].index_normal.norm();
+}
+
+// Each candidate's wall plane: the line (in the plane of A's normal's
+// frame) separating the inside samples of its rings from the outside
+// samples between the flats with the widest margin; `ok` 0 where none does.
+void fit_wall_planes(const Sharpener& sh, const Walls& W, std::vector<Plane>& wall, std::vector<uint8_t>& ok) {
+  wall.assign(W.cand.size(), Plane{});
+  ok.assign(W.cand.size(), 0);
   tbb::enumerable_thread_specific<detail::RingScratch> scratch;
-  tbb::parallel_for(size_t(0), cand.size(), [&](size_t k) {
-    const uint32_t v = cand[k];
-    const auto [A, B] = pair[v];
-    const Vec3 na = seg.flats[size_t(A)].index_normal.normalized();
+  tbb::parallel_for(size_t(0), W.cand.size(), [&](size_t k) {
+    const uint32_t v = W.cand[k];
+    const auto [A, B] = W.pair[v];
+    const Vec3 na = sh.seg.flats[size_t(A)].index_normal.normalized();
     const Vec3 u = na.cross(std::abs(na.x()) < 0.6 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)).normalized(), w = na.cross(u);
     std::vector<Eigen::Vector2d> in, out;
     double lo = 0, hi = 0;
@@ -124,14 +151,14 @@ void Sharpener::fit_walls() {
     constexpr std::pair<uint32_t, double> kAttempts[] = {
         {kWallFitRings, 0.0}, {1, 0.0}, {kWallFitRings, kFlatGap}, {1, kFlatGap}};
     for (const auto& [rings_fit, gap] : kAttempts) {
-      if (gap > 0 && label[v] < 0) break;
+      if (gap > 0 && sh.label[v] < 0) break;
       in.clear();
       out.clear();
-      detail::rings_around(v, rings_fit, adj_off, adj, [&](uint32_t q) { return pair[q] == pair[v]; }, rs);
+      detail::rings_around(v, rings_fit, sh.adj_off, sh.adj, [&](uint32_t q) { return W.pair[q] == W.pair[v]; }, rs);
       for (const auto& [q, d] : rs.out) {
-        const Vec3 pi = s.inside_sample(q), po = s.outside_sample(q);
+        const Vec3 pi = sh.s.inside_sample(q), po = sh.s.outside_sample(q);
         in.emplace_back(u.dot(pi), w.dot(pi));
-        if (between(A, B, po, gap)) out.emplace_back(u.dot(po), w.dot(po));
+        if (between(sh, A, B, po, gap)) out.emplace_back(u.dot(po), w.dot(po));
       }
       if (in.size() < 3 || out.size() < 3) continue;
       double best = -INFINITY, best_a = 0;
@@ -151,6 +178,24 @@ void Sharpener::fit_walls() {
       return;
     }
   });
+}
+
+}  // namespace
+
+void Sharpener::fit_walls() {
+  if (!o.passes.on(Pass::walls)) return;
+  std::vector<uint32_t> fresh;
+  const std::vector<Near> near = flats_near(*this, fresh);
+  const Walls W = wall_candidates(*this, fresh, near);
+  std::vector<Plane> wall;
+  std::vector<uint8_t> ok;
+  fit_wall_planes(*this, W, wall, ok);
+  place_walls(W, wall, ok);
+}
+
+void Sharpener::place_walls(const Walls& W, const std::vector<Plane>& wall, const std::vector<uint8_t>& ok) {
+  const auto& pair = W.pair;
+  const auto& cand = W.cand;
   enum : uint8_t { kUnplaced, kOnFlat, kOnWall };
   std::vector<uint8_t> placed(n, kUnplaced);
   auto make_wall = [&](uint32_t v, double t, const Plane& p) {
@@ -168,7 +213,7 @@ void Sharpener::fit_walls() {
     const auto [A, B] = pair[v];
     if (!ok[k]) continue;
     const double t = stick_crossing(v, wall[k].n, wall[k].c);  // NaN unless crossed outwards
-    if (between(A, B, s.outside_sample(v))) {
+    if (between(*this, A, B, s.outside_sample(v))) {
       if (!std::isnan(t)) make_wall(v, t, wall[k]);
       continue;
     }
@@ -220,6 +265,7 @@ void Sharpener::fit_walls() {
   for (const ToWall& m : to_wall) make_wall(m.v, m.t, plane[m.by]);
   std::erase_if(leftovers, [&](uint32_t v) { return placed[v] != kUnplaced; });
 }
+
 
 uint32_t Sharpener::add_vertex(const NewVertex& v, const Vec3& at) {
   nv.push_back(v);

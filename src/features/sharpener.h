@@ -80,6 +80,8 @@ struct NewVertex {
   std::array<uint32_t, 3> from{kNone, kNone, kNone};  // corner: its three edge vertices
 };
 
+struct Walls;  // sharpen_creases.cpp: the candidates of thin walls
+
 struct Sharpener {
   const StickSurface& s;
   const FlatSegmentation& seg;
@@ -380,6 +382,9 @@ struct Sharpener {
   // the solid, through the wall or the flat; left on a flat mid-rim, they
   // kinked it.
   void fit_walls();
+  // fit_walls' last step: each fitted wall's vertices onto its plane, flat
+  // vertices whose stick leaves through it too.
+  void place_walls(const Walls& W, const std::vector<Plane>& wall, const std::vector<uint8_t>& ok);
 
   uint32_t add_vertex(const NewVertex& v, const Vec3& at);
 
