@@ -37,21 +37,31 @@ struct Bounds {
   Vec3 lo, hi;
 };
 
-}  // namespace
+// The net being built: its vertices (index space, unpadded) and their
+// constraint boxes; per stick slot the patch vertex of that cell and the
+// face vertex on the net edge after it (kNone: none); the polygons.
+struct Net {
+  std::vector<Vec3> x;
+  std::vector<Bounds> box;
+  std::vector<uint32_t> stick_patch, face_vertex;
+  std::vector<uint32_t> poly, poly_off{0};
+};
 
-Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOptions& o, SurfaceNetStats* stats) {
-  if (!(o.threshold > 0)) throw UsageError("the stopping threshold must be > 0");
-  if (o.max_iterations < 0) throw UsageError("the iteration cap must be >= 0");
-  SurfaceNetStats st;
-  auto t0 = std::chrono::steady_clock::now();
-  const size_t ns = surface.stick_count();
+Vec3 stick_midpoint(const StickSurface& surface, size_t s) {
+  Vec3 m = index_vec(surface.lower_index(s));
+  m[surface.axis(s)] += 0.5;
+  return m;
+}
+
+// Triangles grouped by cell, each cell's split into patches (connected
+// triangles: union-find over its <= 12 sticks); a patch vertex at the mean
+// of its sticks' midpoints, boxed by them (Gibson: the whole cell when the
+// cell has one patch).
+void build_patches(const StickSurface& surface, Net& net, SurfaceNetStats& st) {
   const auto& P = surface.padded;
-  auto midpoint = [&](size_t s) {
-    const auto L = surface.lower_index(s);
-    Vec3 m = index_vec(L);
-    m[surface.axis(s)] += 0.5;
-    return m;
-  };
+  auto& x = net.x;
+  auto& box = net.box;
+  auto& stick_patch = net.stick_patch;
 
   // Triangles grouped by cell.
   std::vector<std::pair<uint64_t, uint32_t>> by_cell(surface.triangles.size());
@@ -67,9 +77,6 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
   tbb::parallel_sort(by_cell.begin(), by_cell.end());
 
   // Patches: connected triangles of one cell (union-find over its <= 12 sticks).
-  std::vector<uint32_t> stick_patch(4 * ns, kNone);
-  std::vector<Vec3> x;       // net vertex positions, index space (unpadded)
-  std::vector<Bounds> box;      // their constraint boxes
   for (size_t g = 0; g < by_cell.size();) {
     size_t e = g;
     while (e < by_cell.size() && by_cell[e].first == by_cell[g].first) ++e;
@@ -119,7 +126,7 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
         if (kSlotOffset[k][0] == ob && kSlotOffset[k][1] == oc) slot = k;
       if (slot < 0) throw std::logic_error("surface net: stick outside its cell");
       stick_patch[4 * s + size_t(slot)] = p;
-      const Vec3 m = midpoint(s);
+      const Vec3 m = stick_midpoint(surface, s);
       x[p] += m;
       box[p].lo = box[p].lo.cwiseMin(m);
       box[p].hi = box[p].hi.cwiseMax(m);
@@ -139,9 +146,16 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
   for (uint32_t p : stick_patch)
     if (p == kNone) throw std::logic_error("surface net: a stick misses one of its four cells");
 
-  // Net edges used by four quads: split per ambiguous-face segment. The
-  // segment through stick s on that face cuts off s's inside sample.
-  std::vector<uint32_t> face_vertex(4 * ns, kNone);
+}
+
+// Net edges used by four quads: split per ambiguous-face segment. The
+// segment through stick s on that face cuts off s's inside sample.
+void split_ambiguous_faces(const StickSurface& surface, Net& net, SurfaceNetStats& st) {
+  const size_t ns = surface.stick_count();
+  auto& x = net.x;
+  auto& box = net.box;
+  const auto& stick_patch = net.stick_patch;
+  auto& face_vertex = net.face_vertex;
   {
     struct Use {
       uint32_t u, v;
@@ -200,9 +214,16 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
     }
   }
 
-  // Polygons, wound outward: slots 0,1,2,3 turn counter-clockwise around +a,
-  // which points out of the solid when the stick's lower sample is inside.
-  std::vector<uint32_t> poly, poly_off{0};
+}
+
+// Polygons, wound outward: slots 0,1,2,3 turn counter-clockwise around +a,
+// which points out of the solid when the stick's lower sample is inside.
+void net_polygons(const StickSurface& surface, Net& net, SurfaceNetStats& st) {
+  const size_t ns = surface.stick_count();
+  const auto& stick_patch = net.stick_patch;
+  const auto& face_vertex = net.face_vertex;
+  auto& poly = net.poly;
+  auto& poly_off = net.poly_off;
   poly.reserve(4 * ns + 2 * st.face_vertices);
   for (size_t s = 0; s < ns; ++s) {
     static constexpr int kOut[2][4] = {{0, 3, 2, 1}, {0, 1, 2, 3}};
@@ -218,10 +239,16 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
   }
   st.quads = ns;
 
-  // Net adjacency: with consistent winding every directed polygon edge
-  // occurs once, so "next in my polygons" lists each neighbour exactly once.
-  const size_t nv = x.size();
-  std::vector<uint32_t> off(nv + 1, 0), adj(poly.size());
+}
+
+// Net adjacency: with consistent winding every directed polygon edge
+// occurs once, so "next in my polygons" lists each neighbour exactly once.
+void net_adjacency(const Net& net, std::vector<uint32_t>& off, std::vector<uint32_t>& adj) {
+  const auto& poly = net.poly;
+  const auto& poly_off = net.poly_off;
+  const size_t nv = net.x.size();
+  off.assign(nv + 1, 0);
+  adj.resize(poly.size());
   for (size_t f = 0; f + 1 < poly_off.size(); ++f)
     for (uint32_t i = poly_off[f]; i < poly_off[f + 1]; ++i) ++off[poly[i] + 1];
   for (size_t v = 0; v < nv; ++v) off[v + 1] += off[v];
@@ -232,25 +259,14 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
       for (uint32_t i = b; i < e; ++i) adj[fill[poly[i]]++] = poly[i + 1 == e ? b : i + 1];
     }
   }
-  st.seconds_build = seconds_since(t0);
+}
 
-  // Gibson's relaxation, clamped to the boxes.
-  t0 = std::chrono::steady_clock::now();
-  {
-    ProgressCounter progress(o.progress, "surface net relaxation", uint64_t(o.max_iterations));
-    const detail::Relaxation r = detail::relax(
-        x, off, adj, [&](size_t v, const Vec3& mean) { return Vec3(mean.cwiseMax(box[v].lo).cwiseMin(box[v].hi)); },
-        o.threshold, o.max_iterations, progress);
-    st.iterations = r.iterations;
-    st.last_max_change = r.last_max_change;
-    st.converged = r.converged;
-  }
-  st.seconds_relax = seconds_since(t0);
-
-  Mesh mesh;
-  mesh.positions.resize(nv);
-  for (size_t v = 0; v < nv; ++v) mesh.positions[v] = surface.lattice.to_physical(x[v]);
-  mesh.triangles.reserve(2 * ns + 2 * st.face_vertices);
+// The polygons as triangles: a quad by its shorter diagonal, a polygon
+// through face vertices as a fan from the first of them.
+void triangulate(const Net& net, size_t patch_vertices, Mesh& mesh) {
+  const auto& poly = net.poly;
+  const auto& poly_off = net.poly_off;
+  mesh.triangles.reserve(2 * (poly_off.size() - 1));
   for (size_t f = 0; f + 1 < poly_off.size(); ++f) {
     const uint32_t b = poly_off[f], e = poly_off[f + 1];
     if (e - b == 4) {  // a quad: the shorter diagonal
@@ -267,11 +283,50 @@ Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOption
     }
     // A polygon through face vertices: a fan from the first of them.
     uint32_t apex = b;
-    while (poly[apex] < st.patch_vertices) ++apex;
+    while (poly[apex] < patch_vertices) ++apex;
     const uint32_t len = e - b;
     for (uint32_t i = 1; i + 1 < len; ++i)
       mesh.triangles.push_back({poly[apex], poly[b + (apex - b + i) % len], poly[b + (apex - b + i + 1) % len]});
   }
+}
+
+}  // namespace
+
+Mesh constrained_surface_net(const StickSurface& surface, const SurfaceNetOptions& o, SurfaceNetStats* stats) {
+  if (!(o.threshold > 0)) throw UsageError("the stopping threshold must be > 0");
+  if (o.max_iterations < 0) throw UsageError("the iteration cap must be >= 0");
+  SurfaceNetStats st;
+  auto t0 = std::chrono::steady_clock::now();
+  const size_t ns = surface.stick_count();
+  Net net;
+  net.stick_patch.assign(4 * ns, kNone);
+  net.face_vertex.assign(4 * ns, kNone);
+  build_patches(surface, net, st);
+  split_ambiguous_faces(surface, net, st);
+  net_polygons(surface, net, st);
+  std::vector<uint32_t> off, adj;
+  net_adjacency(net, off, adj);
+  st.seconds_build = seconds_since(t0);
+
+  // Gibson's relaxation, clamped to the boxes.
+  t0 = std::chrono::steady_clock::now();
+  std::vector<Vec3>& x = net.x;
+  {
+    ProgressCounter progress(o.progress, "surface net relaxation", uint64_t(o.max_iterations));
+    const detail::Relaxation r = detail::relax(
+        x, off, adj,
+        [&](size_t v, const Vec3& mean) { return Vec3(mean.cwiseMax(net.box[v].lo).cwiseMin(net.box[v].hi)); },
+        o.threshold, o.max_iterations, progress);
+    st.iterations = r.iterations;
+    st.last_max_change = r.last_max_change;
+    st.converged = r.converged;
+  }
+  st.seconds_relax = seconds_since(t0);
+
+  Mesh mesh;
+  mesh.positions.resize(x.size());
+  for (size_t v = 0; v < x.size(); ++v) mesh.positions[v] = surface.lattice.to_physical(x[v]);
+  triangulate(net, st.patch_vertices, mesh);
   if (surface.lattice.flips_orientation())
     for (Triangle& t : mesh.triangles) std::swap(t[1], t[2]);
   st.triangles = mesh.triangles.size();
