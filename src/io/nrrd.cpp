@@ -178,24 +178,11 @@ std::string nrrd_type_name(ScalarType t) {
 
 }  // namespace
 
-ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* raw) {
-  const Header h = parse_header(path);
-  ScalarVolume v;
-  v.source = path;
-  const std::string* type = field(h, {"type"});
-  const std::string* dimension = field(h, {"dimension"});
-  const std::string* sizes = field(h, {"sizes"});
-  const std::string* encoding = field(h, {"encoding"});
-  if (!type || !dimension || !sizes || !encoding)
-    throw InputError(path, "NRRD header lacks one of the required fields type, dimension, sizes, encoding");
-  v.type = nrrd_type(path, *type);
-  const int64_t dim = parse_int(path, *dimension, "dimension");
-  const auto size_tokens = split_ws(*sizes);
-  if (dim < 2 || dim > 4) throw InputError(path, "NRRD dimension " + std::to_string(dim) + " is not supported (2, 3 or 4)");
-  if (int64_t(size_tokens.size()) != dim) throw InputError(path, "'sizes' does not list 'dimension' values");
-  std::vector<int64_t> n;
-  for (const auto& s : size_tokens) n.push_back(parse_int(path, s, "sizes"));
+namespace {
 
+// The lattice (and the component count of a 4-D list axis) from the header.
+void read_geometry(const std::string& path, const Header& h, int64_t dim, const std::vector<int64_t>& n,
+                   ScalarVolume& v) {
   // Which axis is non-spatial (for 4-D): kinds, else a "none" space direction.
   std::vector<std::string> kinds;
   if (const auto* k = field(h, {"kinds"})) kinds = split_ws(*k);
@@ -269,7 +256,10 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     throw InputError(path, e.what());
   }
 
-  // Metadata and segments.
+}
+
+// The key/value metadata and Slicer's segments.
+void read_segments(const std::string& path, const Header& h, ScalarVolume& v) {
   v.metadata = h.keyvalues;
   for (const auto& [key, value] : h.keyvalues) {
     if (key.rfind("Segment", 0) != 0 || !key.ends_with("_ID")) continue;
@@ -287,6 +277,55 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     if (const auto* ly = get("_Layer")) s.layer = parse_int(path, *ly, prefix + "_Layer");
     v.segments.push_back(s);
   }
+
+}
+
+// The detached data files ('data file', or 'LIST' lines), each checked to
+// exist; empty for data attached after the header.
+std::vector<std::string> data_files(const std::string& path, const Header& h) {
+  std::vector<std::string> files;
+  if (const auto* df = field(h, {"data file", "datafile"})) {
+    const fs::path base = fs::path(path).parent_path();
+    if (df->rfind("LIST", 0) == 0) {
+      for (const auto& f : h.list_files)
+        if (!f.empty()) files.push_back((base / f).string());
+    } else if (split_ws(*df).size() > 1) {
+      throw InputError(path, "NRRD 'data file' with a format pattern is not supported (use a single file or LIST)");
+    } else {
+      files.push_back((base / *df).string());
+    }
+    if (files.empty()) throw InputError(path, "'data file: LIST' names no file");
+    // Named from the header the user gave, with the file it is missing.
+    std::error_code ec;
+    for (const auto& f : files)
+      if (!fs::exists(f, ec)) throw InputError(path, "its data file " + f + " does not exist");
+  } else if (h.detached_header) {
+    throw InputError(path, "the NRRD header has no blank line and no 'data file' field");
+  }
+  return files;
+}
+
+}  // namespace
+
+ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* raw) {
+  const Header h = parse_header(path);
+  ScalarVolume v;
+  v.source = path;
+  const std::string* type = field(h, {"type"});
+  const std::string* dimension = field(h, {"dimension"});
+  const std::string* sizes = field(h, {"sizes"});
+  const std::string* encoding = field(h, {"encoding"});
+  if (!type || !dimension || !sizes || !encoding)
+    throw InputError(path, "NRRD header lacks one of the required fields type, dimension, sizes, encoding");
+  v.type = nrrd_type(path, *type);
+  const int64_t dim = parse_int(path, *dimension, "dimension");
+  const auto size_tokens = split_ws(*sizes);
+  if (dim < 2 || dim > 4) throw InputError(path, "NRRD dimension " + std::to_string(dim) + " is not supported (2, 3 or 4)");
+  if (int64_t(size_tokens.size()) != dim) throw InputError(path, "'sizes' does not list 'dimension' values");
+  std::vector<int64_t> n;
+  for (const auto& s : size_tokens) n.push_back(parse_int(path, s, "sizes"));
+  read_geometry(path, h, dim, n, v);
+  read_segments(path, h, v);
 
   // Payload.
   const size_t vs = scalar_size(v.type);
@@ -308,25 +347,7 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
                                                 : " (must be -1 or more)"));
 
   // Data sources: (file, offset) pairs; attached data lives after the header.
-  std::vector<std::string> files;
-  if (const auto* df = field(h, {"data file", "datafile"})) {
-    const fs::path base = fs::path(path).parent_path();
-    if (df->rfind("LIST", 0) == 0) {
-      for (const auto& f : h.list_files)
-        if (!f.empty()) files.push_back((base / f).string());
-    } else if (split_ws(*df).size() > 1) {
-      throw InputError(path, "NRRD 'data file' with a format pattern is not supported (use a single file or LIST)");
-    } else {
-      files.push_back((base / *df).string());
-    }
-    if (files.empty()) throw InputError(path, "'data file: LIST' names no file");
-    // Named from the header the user gave, with the file it is missing.
-    std::error_code ec;
-    for (const auto& f : files)
-      if (!fs::exists(f, ec)) throw InputError(path, "its data file " + f + " does not exist");
-  } else if (h.detached_header) {
-    throw InputError(path, "the NRRD header has no blank line and no 'data file' field");
-  }
+  const std::vector<std::string> files = data_files(path, h);
   const bool attached = files.empty();
   auto data_start = [&](const std::string& file) -> uint64_t {
     uint64_t off = attached ? h.data_offset : 0;
