@@ -183,7 +183,7 @@ class Lookahead {
       : ctx_(ctx), V_(V),
         threads_(std::min(size_t(tbb::this_task_arena::max_concurrency()),
                           tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
-        detectors_([&ctx] {
+        taken_(ctx.n, 0), detectors_([&ctx] {
           return Detector{ctx.S, ctx.o, ctx.seg.region, std::vector<uint32_t>(ctx.n, 0), 0, ctx.cos_cone,
                           std::vector<uint8_t>(ctx.n, 0)};
         }) {}
@@ -224,7 +224,22 @@ class Lookahead {
     const size_t batch = threads_ <= 1 ? 1 : std::min(4 * threads_, size_t(1) << std::min<size_t>(streak, 10));
     if (batch == 1) return cells;
     auto h = heap;
-    while (!h.empty() && cells.size() < batch) {
+    // Cells sharing no voter with the cells before them in the batch: a
+    // rejection there does not lower their counts, so the loop pops them
+    // before the next acceptance (a neighbouring cell's often falls below
+    // the seed share and its try would be wasted).
+    const uint32_t stamp = ++stamp_;
+    const auto disjoint = [&](size_t c) {
+      for (uint32_t i = V_.cell_begin[c]; i < V_.cell_begin[c + 1]; ++i)
+        if (taken_[V_.voter[i]] == stamp) return false;
+      return true;
+    };
+    const auto take = [&](size_t c) {
+      for (uint32_t i = V_.cell_begin[c]; i < V_.cell_begin[c + 1]; ++i) taken_[V_.voter[i]] = stamp;
+    };
+    take(first);
+    size_t scanned = 0;
+    while (!h.empty() && cells.size() < batch && scanned++ < 8 * batch) {
       const auto [cnt, neg] = h.top();
       h.pop();
       const size_t c = size_t(-neg);
@@ -234,6 +249,8 @@ class Lookahead {
         continue;
       }
       if (double(cnt) < kSeedShare * ctx_.o.min_area) break;
+      if (!disjoint(c)) continue;
+      take(c);
       cells.push_back(c);
     }
     return cells;
@@ -243,6 +260,8 @@ class Lookahead {
   const Votes& V_;
   const size_t threads_;
   std::unordered_map<size_t, Try> tries_;  // since the last acceptance, by cell
+  mutable std::vector<uint32_t> taken_;    // per vertex: the batch stamp of a cell it votes in
+  mutable uint32_t stamp_ = 0;
   size_t tries_version_ = SIZE_MAX;        // `accepted` when tries_ were computed
   tbb::enumerable_thread_specific<Detector> detectors_;
 };

@@ -145,9 +145,6 @@ Votes cast_votes(const Surface& S, double cone);
 
 // t (from the inside sample) where the plane crosses stick v, or NaN when it
 // does not cross it with the margin.
-
-// t (from the inside sample) where the plane crosses stick v, or NaN when it
-// does not cross it with the margin.
 double crossing(const Surface& S, size_t v, const Plane& P, double margin);
 // The largest lambda in [0, 1] such that (1 - lambda) P0 + lambda P1 stabs
 // every stick of `cluster` with the margin (P0 does).
