@@ -141,23 +141,12 @@ class Cursor {
   int mode_;
 };
 
-}  // namespace
-
-Mesh read_ply(const std::string& path, uint64_t max_bytes) {
-  const auto buf = read_whole_file(path, max_bytes, "the file");
-  const char* data = reinterpret_cast<const char*>(buf.data());
-  const std::string head(data, std::min<size_t>(buf.size(), 1 << 20));
-  if (head.rfind("ply", 0) != 0 || head.size() < 4 || (head[3] != '\n' && head[3] != '\r'))
-    throw InputError(path, "not a PLY file (missing the 'ply' magic line)");
-  size_t end_header = head.find("end_header");
-  if (end_header == std::string::npos) throw InputError(path, "PLY header has no end_header line");
-  size_t body = head.find('\n', end_header);
-  if (body == std::string::npos) throw InputError(path, "truncated PLY header");
-  ++body;
-  std::istringstream hs(head.substr(0, end_header));
+// The header's format (0 ascii, 1 binary little-endian, 2 big-endian) and
+// elements, from the text before end_header.
+int parse_ply_header(const std::string& path, const std::string& text, std::vector<Element>& elements) {
+  std::istringstream hs(text);
   std::string line;
   int mode = -1;
-  std::vector<Element> elements;
   std::getline(hs, line);  // "ply"
   while (std::getline(hs, line)) {
     const auto tok = split_ws(line);
@@ -200,6 +189,158 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
     }
   }
   if (mode < 0) throw InputError(path, "PLY header has no format line");
+  return mode;
+}
+
+// The vertex element: positions, and normals, colours and other scalar
+// properties when present.
+void read_ply_vertices(const std::string& path, const Element& e, Cursor& cur, uint64_t max_bytes, Mesh& m) {
+  check_limit(path, e.count * 48, max_bytes, "the vertices");
+  int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1;
+  std::vector<int> other;
+  for (int k = 0; k < int(e.props.size()); ++k) {
+    const Property& p = e.props[size_t(k)];
+    if (p.list) continue;
+    const std::string& n = p.name;
+    int* slot = n == "x" ? &ix : n == "y" ? &iy : n == "z" ? &iz : n == "nx" ? &inx : n == "ny" ? &iny
+              : n == "nz" ? &inz : (n == "red" || n == "r") ? &ir : (n == "green" || n == "g") ? &ig
+              : (n == "blue" || n == "b") ? &ib : (n == "alpha" || n == "a") ? &ia : nullptr;
+    if (slot && *slot < 0)
+      *slot = k;
+    else
+      other.push_back(k);
+  }
+  if (ix < 0 || iy < 0 || iz < 0) throw InputError(path, "PLY vertices lack x, y or z");
+  const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
+  const bool colors = ir >= 0 && ig >= 0 && ib >= 0;
+  m.positions.resize(e.count);
+  if (normals) m.normals.resize(e.count);
+  if (colors) m.colors.resize(e.count);
+  for (int k : other) m.vertex_attributes.push_back({e.props[size_t(k)].name, to_scalar(e.props[size_t(k)].type), {}});
+  std::vector<double> rec(e.props.size());
+  for (uint64_t v = 0; v < e.count; ++v) {
+    for (size_t k = 0; k < e.props.size(); ++k) {
+      const Property& p = e.props[k];
+      if (p.list) {
+        const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'vertex'");
+        for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
+      } else {
+        rec[k] = cur.read(p.type);
+      }
+    }
+    m.positions[v] = Vec3(rec[size_t(ix)], rec[size_t(iy)], rec[size_t(iz)]);
+    if (normals) m.normals[v] = Vec3(rec[size_t(inx)], rec[size_t(iny)], rec[size_t(inz)]);
+    if (colors) {
+      auto c = [&](int k) {
+        const bool fl = e.props[size_t(k)].type == PType::f32 || e.props[size_t(k)].type == PType::f64;
+        const double x = fl ? rec[size_t(k)] * 255.0 : rec[size_t(k)];
+        return uint8_t(std::clamp(std::lround(x), 0L, 255L));
+      };
+      m.colors[v] = {c(ir), c(ig), c(ib), ia >= 0 ? c(ia) : uint8_t(255)};
+    }
+    for (size_t a = 0; a < other.size(); ++a) m.vertex_attributes[a].values.push_back(rec[size_t(other[a])]);
+  }
+}
+
+// The face element: triangles (polygons as fans) and scalar face properties.
+void read_ply_faces(const std::string& path, const Element& e, Cursor& cur, uint64_t max_bytes, Mesh& m) {
+  check_limit(path, e.count * 12, max_bytes, "the faces");
+  int idx = -1;
+  std::vector<int> other;
+  for (int k = 0; k < int(e.props.size()); ++k) {
+    const Property& p = e.props[size_t(k)];
+    if (p.list && idx < 0 && (p.name == "vertex_indices" || p.name == "vertex_index"))
+      idx = k;
+    else if (!p.list)
+      other.push_back(k);
+  }
+  if (idx < 0) throw InputError(path, "PLY faces lack a vertex_indices list");
+  for (int k : other) m.face_attributes.push_back({e.props[size_t(k)].name, to_scalar(e.props[size_t(k)].type), {}});
+  m.triangles.reserve(e.count);
+  std::vector<double> rec(e.props.size());
+  std::vector<uint32_t> poly;
+  for (uint64_t f = 0; f < e.count; ++f) {
+    poly.clear();
+    for (size_t k = 0; k < e.props.size(); ++k) {
+      const Property& p = e.props[k];
+      if (p.list) {
+        const uint64_t n = cur.length(p.count_type, 1e6, "face " + std::to_string(f) + " has an invalid vertex count");
+        for (uint64_t q = 0; q < n; ++q) {
+          const double x = cur.read(p.type);
+          if (int(k) == idx) {
+            if (!whole_in(x, 0, 4294967294.0))
+              throw InputError(path, "face " + std::to_string(f) + " has an invalid vertex index");
+            poly.push_back(uint32_t(x));
+          }
+        }
+      } else {
+        rec[k] = cur.read(p.type);
+      }
+    }
+    if (poly.size() < 3) throw InputError(path, "face " + std::to_string(f) + " has fewer than 3 vertices");
+    for (size_t q = 1; q + 1 < poly.size(); ++q) {
+      m.triangles.push_back({poly[0], poly[q], poly[q + 1]});
+      for (size_t a = 0; a < other.size(); ++a) m.face_attributes[a].values.push_back(rec[size_t(other[a])]);
+    }
+  }
+}
+
+// Labelled edges (vertex1, vertex2; other properties skipped).
+void read_ply_edges(const std::string& path, const Element& e, Cursor& cur, uint64_t max_bytes, Mesh& m) {
+  int i1 = -1, i2 = -1;
+  for (int k = 0; k < int(e.props.size()); ++k) {
+    if (e.props[size_t(k)].list) continue;
+    if (e.props[size_t(k)].name == "vertex1") i1 = k;
+    if (e.props[size_t(k)].name == "vertex2") i2 = k;
+  }
+  check_limit(path, e.count * 8, max_bytes, "the edges");
+  std::vector<double> rec(e.props.size());
+  for (uint64_t r = 0; r < e.count; ++r) {
+    for (size_t k = 0; k < e.props.size(); ++k) {
+      const Property& p = e.props[k];
+      if (p.list) {
+        const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'edge'");
+        for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
+      } else {
+        rec[k] = cur.read(p.type);
+      }
+    }
+    if (i1 < 0 || i2 < 0) continue;
+    const double a = rec[size_t(i1)], b = rec[size_t(i2)];
+    if (!whole_in(a, 0, 4294967294.0) || !whole_in(b, 0, 4294967294.0))
+      throw InputError(path, "edge " + std::to_string(r) + " has an invalid vertex index");
+    m.edges.push_back({uint32_t(a), uint32_t(b)});
+  }
+}
+
+// Any other element, read past.
+void skip_ply_element(const Element& e, Cursor& cur) {
+  for (uint64_t r = 0; r < e.count; ++r)
+    for (const Property& p : e.props) {
+      if (p.list) {
+        const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element '" + e.name + "'");
+        for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
+      } else {
+        cur.read(p.type);
+      }
+    }
+}
+
+}  // namespace
+
+Mesh read_ply(const std::string& path, uint64_t max_bytes) {
+  const auto buf = read_whole_file(path, max_bytes, "the file");
+  const char* data = reinterpret_cast<const char*>(buf.data());
+  const std::string head(data, std::min<size_t>(buf.size(), 1 << 20));
+  if (head.rfind("ply", 0) != 0 || head.size() < 4 || (head[3] != '\n' && head[3] != '\r'))
+    throw InputError(path, "not a PLY file (missing the 'ply' magic line)");
+  size_t end_header = head.find("end_header");
+  if (end_header == std::string::npos) throw InputError(path, "PLY header has no end_header line");
+  size_t body = head.find('\n', end_header);
+  if (body == std::string::npos) throw InputError(path, "truncated PLY header");
+  ++body;
+  std::vector<Element> elements;
+  const int mode = parse_ply_header(path, head.substr(0, end_header), elements);
 
   Mesh m;
   Cursor cur(path, data + body, data + buf.size(), mode);
@@ -215,128 +356,14 @@ Mesh read_ply(const std::string& path, uint64_t max_bytes) {
     if (e.props.empty() && e.name != "vertex" && e.name != "face") continue;
     if (e.name == "vertex" && !have_vertices) {
       have_vertices = true;
-      check_limit(path, e.count * 48, max_bytes, "the vertices");
-      int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1;
-      std::vector<int> other;
-      for (int k = 0; k < int(e.props.size()); ++k) {
-        const Property& p = e.props[size_t(k)];
-        if (p.list) continue;
-        const std::string& n = p.name;
-        int* slot = n == "x" ? &ix : n == "y" ? &iy : n == "z" ? &iz : n == "nx" ? &inx : n == "ny" ? &iny
-                  : n == "nz" ? &inz : (n == "red" || n == "r") ? &ir : (n == "green" || n == "g") ? &ig
-                  : (n == "blue" || n == "b") ? &ib : (n == "alpha" || n == "a") ? &ia : nullptr;
-        if (slot && *slot < 0)
-          *slot = k;
-        else
-          other.push_back(k);
-      }
-      if (ix < 0 || iy < 0 || iz < 0) throw InputError(path, "PLY vertices lack x, y or z");
-      const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
-      const bool colors = ir >= 0 && ig >= 0 && ib >= 0;
-      m.positions.resize(e.count);
-      if (normals) m.normals.resize(e.count);
-      if (colors) m.colors.resize(e.count);
-      for (int k : other) m.vertex_attributes.push_back({e.props[size_t(k)].name, to_scalar(e.props[size_t(k)].type), {}});
-      std::vector<double> rec(e.props.size());
-      for (uint64_t v = 0; v < e.count; ++v) {
-        for (size_t k = 0; k < e.props.size(); ++k) {
-          const Property& p = e.props[k];
-          if (p.list) {
-            const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'vertex'");
-            for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
-          } else {
-            rec[k] = cur.read(p.type);
-          }
-        }
-        m.positions[v] = Vec3(rec[size_t(ix)], rec[size_t(iy)], rec[size_t(iz)]);
-        if (normals) m.normals[v] = Vec3(rec[size_t(inx)], rec[size_t(iny)], rec[size_t(inz)]);
-        if (colors) {
-          auto c = [&](int k) {
-            const bool fl = e.props[size_t(k)].type == PType::f32 || e.props[size_t(k)].type == PType::f64;
-            const double x = fl ? rec[size_t(k)] * 255.0 : rec[size_t(k)];
-            return uint8_t(std::clamp(std::lround(x), 0L, 255L));
-          };
-          m.colors[v] = {c(ir), c(ig), c(ib), ia >= 0 ? c(ia) : uint8_t(255)};
-        }
-        for (size_t a = 0; a < other.size(); ++a) m.vertex_attributes[a].values.push_back(rec[size_t(other[a])]);
-      }
+      read_ply_vertices(path, e, cur, max_bytes, m);
     } else if (e.name == "face" && !have_faces) {
       have_faces = true;
-      check_limit(path, e.count * 12, max_bytes, "the faces");
-      int idx = -1;
-      std::vector<int> other;
-      for (int k = 0; k < int(e.props.size()); ++k) {
-        const Property& p = e.props[size_t(k)];
-        if (p.list && idx < 0 && (p.name == "vertex_indices" || p.name == "vertex_index"))
-          idx = k;
-        else if (!p.list)
-          other.push_back(k);
-      }
-      if (idx < 0) throw InputError(path, "PLY faces lack a vertex_indices list");
-      for (int k : other) m.face_attributes.push_back({e.props[size_t(k)].name, to_scalar(e.props[size_t(k)].type), {}});
-      m.triangles.reserve(e.count);
-      std::vector<double> rec(e.props.size());
-      std::vector<uint32_t> poly;
-      for (uint64_t f = 0; f < e.count; ++f) {
-        poly.clear();
-        for (size_t k = 0; k < e.props.size(); ++k) {
-          const Property& p = e.props[k];
-          if (p.list) {
-            const uint64_t n = cur.length(p.count_type, 1e6, "face " + std::to_string(f) + " has an invalid vertex count");
-            for (uint64_t q = 0; q < n; ++q) {
-              const double x = cur.read(p.type);
-              if (int(k) == idx) {
-                if (!whole_in(x, 0, 4294967294.0))
-                  throw InputError(path, "face " + std::to_string(f) + " has an invalid vertex index");
-                poly.push_back(uint32_t(x));
-              }
-            }
-          } else {
-            rec[k] = cur.read(p.type);
-          }
-        }
-        if (poly.size() < 3) throw InputError(path, "face " + std::to_string(f) + " has fewer than 3 vertices");
-        for (size_t q = 1; q + 1 < poly.size(); ++q) {
-          m.triangles.push_back({poly[0], poly[q], poly[q + 1]});
-          for (size_t a = 0; a < other.size(); ++a) m.face_attributes[a].values.push_back(rec[size_t(other[a])]);
-        }
-      }
+      read_ply_faces(path, e, cur, max_bytes, m);
     } else if (e.name == "edge" && m.edges.empty()) {
-      // Labelled edges (vertex1, vertex2; other properties skipped).
-      int i1 = -1, i2 = -1;
-      for (int k = 0; k < int(e.props.size()); ++k) {
-        if (e.props[size_t(k)].list) continue;
-        if (e.props[size_t(k)].name == "vertex1") i1 = k;
-        if (e.props[size_t(k)].name == "vertex2") i2 = k;
-      }
-      check_limit(path, e.count * 8, max_bytes, "the edges");
-      std::vector<double> rec(e.props.size());
-      for (uint64_t r = 0; r < e.count; ++r) {
-        for (size_t k = 0; k < e.props.size(); ++k) {
-          const Property& p = e.props[k];
-          if (p.list) {
-            const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'edge'");
-            for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
-          } else {
-            rec[k] = cur.read(p.type);
-          }
-        }
-        if (i1 < 0 || i2 < 0) continue;
-        const double a = rec[size_t(i1)], b = rec[size_t(i2)];
-        if (!whole_in(a, 0, 4294967294.0) || !whole_in(b, 0, 4294967294.0))
-          throw InputError(path, "edge " + std::to_string(r) + " has an invalid vertex index");
-        m.edges.push_back({uint32_t(a), uint32_t(b)});
-      }
+      read_ply_edges(path, e, cur, max_bytes, m);
     } else {
-      for (uint64_t r = 0; r < e.count; ++r)
-        for (const Property& p : e.props) {
-          if (p.list) {
-            const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element '" + e.name + "'");
-            for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
-          } else {
-            cur.read(p.type);
-          }
-        }
+      skip_ply_element(e, cur);
     }
   }
   if (!have_vertices) throw InputError(path, "PLY file has no vertex element");
