@@ -217,24 +217,34 @@ void check_scene(const std::string& path, const Reach& reach, uint64_t cap) {
 
 }  // namespace
 
-VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
-  const uint64_t cap = options.max_bytes ? options.max_bytes : default_memory_limit();
-  const auto data = read_whole_file(path, cap, "reading the .vox file");
+namespace {
+
+// The file's chunks: models, palette, scene nodes and layers.
+struct VoxChunks {
+  uint32_t version = 0;
+  std::vector<VoxModel> models;
+  std::array<Rgba, 256> palette = magicavoxel_default_palette();
+  bool has_palette = false;
+  std::map<int32_t, SceneNode> nodes;
+  std::map<int32_t, bool> hidden_layers;
+};
+
+VoxChunks read_vox_chunks(const std::string& path, const std::vector<std::byte>& data, uint64_t cap) {
   ByteCursor c(path, data, 0, data.size());
   if (c.left() < 8 || c.text(4, "header") != "VOX ") throw InputError(path, "not a MagicaVoxel file (no 'VOX ' magic)");
-  const uint32_t version = c.u32("header");
+  VoxChunks out;
+  out.version = c.u32("header");
   if (c.text(4, "MAIN chunk") != "MAIN") throw InputError(path, "no MAIN chunk after the header");
   const uint32_t main_content = c.u32("MAIN chunk"), main_children = c.u32("MAIN chunk");
   c.skip(main_content, "MAIN chunk");
   if (main_children > c.left()) throw InputError(path, "truncated: MAIN declares " + std::to_string(main_children) +
                                                            " bytes of chunks, " + std::to_string(c.left()) + " remain");
   const size_t end = c.pos() + main_children;
-
-  std::vector<VoxModel> models;
-  std::array<Rgba, 256> palette = magicavoxel_default_palette();
-  bool has_palette = false;
-  std::map<int32_t, SceneNode> nodes;
-  std::map<int32_t, bool> hidden_layers;
+  auto& models = out.models;
+  auto& palette = out.palette;
+  auto& has_palette = out.has_palette;
+  auto& nodes = out.nodes;
+  auto& hidden_layers = out.hidden_layers;
   uint64_t voxel_total = 0;
   while (c.pos() < end) {
     ByteCursor head(path, data, c.pos(), end);
@@ -315,18 +325,72 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
     }
   }
   if (models.empty()) throw InputError(path, "no model (SIZE / XYZI chunks) in the file");
+  return out;
+}
+
+struct Instance {
+  size_t model;
+  Placement place;
+};
+
+// The shape instances of the scene graph from node 0 (hidden nodes and
+// layers left out), each placed by `centred`.
+template <class Centred>
+std::vector<Instance> scene_instances(const std::string& path, const VoxChunks& f, Centred&& centred) {
+  const auto& nodes = f.nodes;
+  const auto& hidden_layers = f.hidden_layers;
+  const auto& models = f.models;
+  std::vector<Instance> instances;
+  // Walk the scene graph from node 0 with an explicit stack; a path longer
+  // than the number of nodes means a cycle.
+  struct Item {
+    int32_t node;
+    Placement place;
+    size_t depth;
+  };
+  std::vector<Item> stack{{0, Placement{}, 0}};
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    if (it.depth > nodes.size()) throw InputError(path, "the scene graph has a cycle");
+    auto found = nodes.find(it.node);
+    if (found == nodes.end()) throw InputError(path, "scene node " + std::to_string(it.node) + " is referenced but missing");
+    const SceneNode& n = found->second;
+    if (n.kind == SceneNode::transform) {
+      auto h = n.attributes.find("_hidden");
+      if (h != n.attributes.end() && h->second == "1") continue;
+      if (auto l = hidden_layers.find(n.layer); l != hidden_layers.end() && l->second) continue;
+      stack.push_back({n.children[0], parse_frame(path, n.frame).then(it.place), it.depth + 1});
+    } else if (n.kind == SceneNode::group) {
+      for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch) stack.push_back({*ch, it.place, it.depth + 1});
+    } else {
+      for (int32_t m : n.children) {
+        if (m < 0 || size_t(m) >= models.size())
+          throw InputError(path, "shape node " + std::to_string(it.node) + " uses model " + std::to_string(m) +
+                                     " but the file has " + std::to_string(models.size()));
+        instances.push_back({size_t(m), centred(size_t(m), it.place)});
+      }
+    }
+  }
+  return instances;
+}
+
+}  // namespace
+
+VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
+  const uint64_t cap = options.max_bytes ? options.max_bytes : default_memory_limit();
+  const auto data = read_whole_file(path, cap, "reading the .vox file");
+  const VoxChunks f = read_vox_chunks(path, data, cap);
+  const auto& models = f.models;
+  const auto& nodes = f.nodes;
 
   // Which models go where.
-  struct Instance {
-    size_t model;
-    Placement place;
-  };
   std::vector<Instance> instances;
   VoxelArt art;
   art.source = path;
   art.format = "vox";
-  art.notes.push_back("version " + std::to_string(version) + ", " + std::to_string(models.size()) + " model(s), " +
-                      (has_palette ? "RGBA palette" : "default palette"));
+  art.notes.push_back("version " + std::to_string(f.version) + ", " + std::to_string(models.size()) + " model(s), " +
+                      (f.has_palette ? "RGBA palette" : "default palette"));
   auto centred = [&](size_t m, const Placement& p) {
     Placement q;  // v -> p(v - floor(s / 2))
     for (size_t a = 0; a < 3; ++a) q.t[a] = -(models[m].size[a] / 2);
@@ -349,44 +413,14 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
     centred_reach[m] = r.placed(centred(m, Placement{}));
   }
   const Reach reach = options.model >= 0 ? model_reach[size_t(options.model)]
-                      : nodes.count(0)   ? scene_reach(path, nodes, hidden_layers, centred_reach, 0)
+                      : nodes.count(0)   ? scene_reach(path, nodes, f.hidden_layers, centred_reach, 0)
                                          : model_reach[0];
   check_scene(path, reach, cap);
   if (options.model >= 0) {
     instances.push_back({size_t(options.model), Placement{}});
     art.notes.push_back("model " + std::to_string(options.model) + " only, untransformed");
   } else if (nodes.count(0)) {
-    // Walk the scene graph from node 0 with an explicit stack; a path longer
-    // than the number of nodes means a cycle.
-    struct Item {
-      int32_t node;
-      Placement place;
-      size_t depth;
-    };
-    std::vector<Item> stack{{0, Placement{}, 0}};
-    while (!stack.empty()) {
-      Item it = stack.back();
-      stack.pop_back();
-      if (it.depth > nodes.size()) throw InputError(path, "the scene graph has a cycle");
-      auto found = nodes.find(it.node);
-      if (found == nodes.end()) throw InputError(path, "scene node " + std::to_string(it.node) + " is referenced but missing");
-      const SceneNode& n = found->second;
-      if (n.kind == SceneNode::transform) {
-        auto h = n.attributes.find("_hidden");
-        if (h != n.attributes.end() && h->second == "1") continue;
-        if (auto l = hidden_layers.find(n.layer); l != hidden_layers.end() && l->second) continue;
-        stack.push_back({n.children[0], parse_frame(path, n.frame).then(it.place), it.depth + 1});
-      } else if (n.kind == SceneNode::group) {
-        for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch) stack.push_back({*ch, it.place, it.depth + 1});
-      } else {
-        for (int32_t m : n.children) {
-          if (m < 0 || size_t(m) >= models.size())
-            throw InputError(path, "shape node " + std::to_string(it.node) + " uses model " + std::to_string(m) +
-                                       " but the file has " + std::to_string(models.size()));
-          instances.push_back({size_t(m), centred(size_t(m), it.place)});
-        }
-      }
-    }
+    instances = scene_instances(path, f, centred);
     art.notes.push_back(std::to_string(instances.size()) + " shape instance(s) from the scene graph");
   } else {
     instances.push_back({0, Placement{}});
@@ -406,7 +440,7 @@ VoxelArt read_vox(const std::string& path, const VoxelArtReadOptions& options) {
     for (const auto& v : models[in.model].voxels) {
       if (v[3] == 0) continue;  // index 0 is "empty" in MagicaVoxel
       const auto w = in.place.apply({v[0], v[1], v[2]});
-      Rgba col = palette[v[3]];
+      Rgba col = f.palette[v[3]];
       col[3] = 255;
       g.voxels[g.index(w[0] - lo[0], w[1] - lo[1], w[2] - lo[2])] = col;
     }
