@@ -81,43 +81,53 @@ void add_problem(MeshCheck& r, size_t count, const std::string& what, const std:
 
 }  // namespace
 
-MeshCheck check_mesh(const Mesh& mesh, const MeshCheckOptions& options) {
-  MeshCheck r;
+namespace {
+
+// 1. Indices: false (the check stops) on an out-of-range index or a
+// non-finite coordinate.
+bool check_indices(const Mesh& mesh, const MeshCheckOptions& options, MeshCheck& r) {
   const auto& P = mesh.positions;
   const auto& T = mesh.triangles;
-  r.vertices = P.size();
-  r.faces = T.size();
   const size_t cap = options.max_examples;
-
-  // 1. Indices and degeneracy.
-  {
-    std::vector<std::string> ex;
-    for (size_t f = 0; f < T.size(); ++f)
-      if (T[f][0] >= P.size() || T[f][1] >= P.size() || T[f][2] >= P.size()) {
-        if (r.invalid_indices++ < cap) ex.push_back("face " + std::to_string(f));
-      }
-    add_problem(r, r.invalid_indices, "faces with out-of-range vertex indices", ex);
-    if (r.invalid_indices) return r;
-    for (const Vec3& p : P)
-      if (!p.allFinite()) {
-        r.problems.push_back("non-finite vertex coordinates");
-        return r;
-      }
-  }
-  std::vector<uint8_t> degenerate(T.size(), 0);
-  {
-    std::vector<std::string> ex;
-    for (size_t f = 0; f < T.size(); ++f) {
-      const Triangle& t = T[f];
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || detail::triangle_degenerate(P[t[0]], P[t[1]], P[t[2]])) {
-        degenerate[f] = 1;
-        if (r.degenerate_faces++ < cap) ex.push_back("face " + std::to_string(f));
-      }
+  std::vector<std::string> ex;
+  for (size_t f = 0; f < T.size(); ++f)
+    if (T[f][0] >= P.size() || T[f][1] >= P.size() || T[f][2] >= P.size()) {
+      if (r.invalid_indices++ < cap) ex.push_back("face " + std::to_string(f));
     }
-    add_problem(r, r.degenerate_faces, "degenerate faces (repeated or collinear corners)", ex);
-  }
+  add_problem(r, r.invalid_indices, "faces with out-of-range vertex indices", ex);
+  if (r.invalid_indices) return false;
+  for (const Vec3& p : P)
+    if (!p.allFinite()) {
+      r.problems.push_back("non-finite vertex coordinates");
+      return false;
+    }
+  return true;
+}
 
-  // 2. Edges.
+// Degenerate faces (repeated or collinear corners), flagged.
+std::vector<uint8_t> check_degenerate(const Mesh& mesh, const MeshCheckOptions& options, MeshCheck& r) {
+  const auto& P = mesh.positions;
+  const auto& T = mesh.triangles;
+  const size_t cap = options.max_examples;
+  std::vector<uint8_t> degenerate(T.size(), 0);
+  std::vector<std::string> ex;
+  for (size_t f = 0; f < T.size(); ++f) {
+    const Triangle& t = T[f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || detail::triangle_degenerate(P[t[0]], P[t[1]], P[t[2]])) {
+      degenerate[f] = 1;
+      if (r.degenerate_faces++ < cap) ex.push_back("face " + std::to_string(f));
+    }
+  }
+  add_problem(r, r.degenerate_faces, "degenerate faces (repeated or collinear corners)", ex);
+  return degenerate;
+}
+
+// 2. Edges: boundary, non-manifold and misoriented; faces joined across
+// edges (components) and corners across manifold edges (vertex fans).
+void check_edges(const Mesh& mesh, const MeshCheckOptions& options, MeshCheck& r, UnionFind& corners,
+                 UnionFind& faces) {
+  const auto& T = mesh.triangles;
+  const size_t cap = options.max_examples;
   std::vector<HalfEdge> he;
   he.reserve(3 * T.size());
   for (size_t f = 0; f < T.size(); ++f) {
@@ -129,124 +139,145 @@ MeshCheck check_mesh(const Mesh& mesh, const MeshCheckOptions& options) {
     }
   }
   tbb::parallel_sort(he.begin(), he.end());
-  UnionFind corners(3 * T.size());
-  UnionFind faces(T.size());
-  {
-    std::vector<std::string> exb, exn, exm;
-    for (size_t i = 0; i < he.size();) {
-      size_t j = i;
-      while (j < he.size() && he[j].key == he[i].key) ++j;
-      const size_t n = j - i;
-      ++r.edges;
-      for (size_t k = i + 1; k < j; ++k) faces.unite(he[i].face, he[k].face);
-      if (n == 1) {
-        if (r.boundary_edges++ < cap) exb.push_back(edge_name(he[i].key));
-      } else if (n > 2) {
-        if (r.nonmanifold_edges++ < cap) exn.push_back(edge_name(he[i].key) + " (" + std::to_string(n) + " faces)");
-      } else {
-        if (he[i].forward == he[i + 1].forward) {
-          if (r.misoriented_edges++ < cap) exm.push_back(edge_name(he[i].key));
-        }
-        // Join the corners of both end vertices across the edge.
-        for (uint32_t vtx : {uint32_t(he[i].key >> 32), uint32_t(he[i].key & 0xffffffffu)}) {
-          auto corner_of = [&](const HalfEdge& h) {
-            const Triangle& t = T[h.face];
-            for (int c = 0; c < 3; ++c)
-              if (t[c] == vtx) return 3 * size_t(h.face) + size_t(c);
-            return size_t(0);
-          };
-          corners.unite(corner_of(he[i]), corner_of(he[i + 1]));
-        }
+  std::vector<std::string> exb, exn, exm;
+  for (size_t i = 0; i < he.size();) {
+    size_t j = i;
+    while (j < he.size() && he[j].key == he[i].key) ++j;
+    const size_t n = j - i;
+    ++r.edges;
+    for (size_t k = i + 1; k < j; ++k) faces.unite(he[i].face, he[k].face);
+    if (n == 1) {
+      if (r.boundary_edges++ < cap) exb.push_back(edge_name(he[i].key));
+    } else if (n > 2) {
+      if (r.nonmanifold_edges++ < cap) exn.push_back(edge_name(he[i].key) + " (" + std::to_string(n) + " faces)");
+    } else {
+      if (he[i].forward == he[i + 1].forward) {
+        if (r.misoriented_edges++ < cap) exm.push_back(edge_name(he[i].key));
       }
-      i = j;
-    }
-    add_problem(r, r.boundary_edges, "boundary edges (the mesh is not closed)", exb);
-    add_problem(r, r.nonmanifold_edges, "non-manifold edges", exn);
-    add_problem(r, r.misoriented_edges, "edges whose two faces have inconsistent orientation", exm);
-  }
-
-  // 3. Vertex fans.
-  {
-    std::vector<int64_t> first_root(P.size(), -1);
-    std::vector<uint8_t> pinched(P.size(), 0);
-    for (size_t f = 0; f < T.size(); ++f) {
-      const Triangle& t = T[f];
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-      for (int c = 0; c < 3; ++c) {
-        const int64_t root = int64_t(corners.find(3 * f + size_t(c)));
-        int64_t& fr = first_root[t[c]];
-        if (fr < 0)
-          fr = root;
-        else if (fr != root)
-          pinched[t[c]] = 1;
+      // Join the corners of both end vertices across the edge.
+      for (uint32_t vtx : {uint32_t(he[i].key >> 32), uint32_t(he[i].key & 0xffffffffu)}) {
+        auto corner_of = [&](const HalfEdge& h) {
+          const Triangle& t = T[h.face];
+          for (int c = 0; c < 3; ++c)
+            if (t[c] == vtx) return 3 * size_t(h.face) + size_t(c);
+          return size_t(0);
+        };
+        corners.unite(corner_of(he[i]), corner_of(he[i + 1]));
       }
     }
-    std::vector<std::string> exv, exu;
-    for (size_t v = 0; v < P.size(); ++v) {
-      if (first_root[v] < 0) {
-        if (r.unreferenced_vertices++ < cap) exu.push_back("vertex " + std::to_string(v));
-      } else if (pinched[v]) {
-        if (r.nonmanifold_vertices++ < cap) exv.push_back("vertex " + std::to_string(v));
-      }
-    }
-    add_problem(r, r.nonmanifold_vertices, "non-manifold vertices (more than one fan of faces)", exv);
-    add_problem(r, r.unreferenced_vertices, "unreferenced vertices", exu);
+    i = j;
   }
+  add_problem(r, r.boundary_edges, "boundary edges (the mesh is not closed)", exb);
+  add_problem(r, r.nonmanifold_edges, "non-manifold edges", exn);
+  add_problem(r, r.misoriented_edges, "edges whose two faces have inconsistent orientation", exm);
+}
 
-  // 4. Global measures.
-  {
-    size_t referenced = r.vertices - r.unreferenced_vertices;
-    size_t nf = 0;
-    for (size_t f = 0; f < T.size(); ++f) {
-      const Triangle& t = T[f];
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-      ++nf;
-      if (faces.find(f) == f) ++r.components;
-      r.area += 0.5 * (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]).norm();
+// 3. Vertex fans: pinched and unreferenced vertices.
+void check_fans(const Mesh& mesh, const MeshCheckOptions& options, MeshCheck& r, UnionFind& corners) {
+  const auto& P = mesh.positions;
+  const auto& T = mesh.triangles;
+  const size_t cap = options.max_examples;
+  std::vector<int64_t> first_root(P.size(), -1);
+  std::vector<uint8_t> pinched(P.size(), 0);
+  for (size_t f = 0; f < T.size(); ++f) {
+    const Triangle& t = T[f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int c = 0; c < 3; ++c) {
+      const int64_t root = int64_t(corners.find(3 * f + size_t(c)));
+      int64_t& fr = first_root[t[c]];
+      if (fr < 0)
+        fr = root;
+      else if (fr != root)
+        pinched[t[c]] = 1;
     }
-    r.euler = int64_t(referenced) - int64_t(r.edges) + int64_t(nf);
-    r.signed_volume = signed_volume(mesh);
-    if (r.closed() && r.manifold() && r.oriented() && r.faces > 0 && r.signed_volume < 0)
-      r.problems.push_back("inward orientation: the enclosed volume is negative (" + std::to_string(r.signed_volume) +
-                           ")");
   }
+  std::vector<std::string> exv, exu;
+  for (size_t v = 0; v < P.size(); ++v) {
+    if (first_root[v] < 0) {
+      if (r.unreferenced_vertices++ < cap) exu.push_back("vertex " + std::to_string(v));
+    } else if (pinched[v]) {
+      if (r.nonmanifold_vertices++ < cap) exv.push_back("vertex " + std::to_string(v));
+    }
+  }
+  add_problem(r, r.nonmanifold_vertices, "non-manifold vertices (more than one fan of faces)", exv);
+  add_problem(r, r.unreferenced_vertices, "unreferenced vertices", exu);
+}
 
-  // 5. Self-intersections.
-  if (options.self_intersections && !T.empty()) {
-    std::vector<detail::Aabb> boxes(T.size());
-    std::vector<uint32_t> ids;
-    for (size_t f = 0; f < T.size(); ++f) {
-      if (degenerate[f]) continue;
-      detail::Aabb b;
-      for (uint32_t v : T[f]) b.grow(P[v]);
-      boxes[ids.size()] = b;
-      ids.push_back(uint32_t(f));
-    }
-    boxes.resize(ids.size());
-    const detail::Bvh bvh(boxes);
-    std::atomic<size_t> count{0};
-    std::mutex m;
-    std::set<std::pair<uint32_t, uint32_t>> examples;  // the smallest pairs, deterministic
-    bvh.for_each_overlapping_pair([&](uint32_t a, uint32_t b) {
-      const uint32_t fa = ids[a], fb = ids[b];
-      const Triangle& ta = T[fa];
-      const Triangle& tb = T[fb];
-      const Vec3 pa[3] = {P[ta[0]], P[ta[1]], P[ta[2]]};
-      const Vec3 pb[3] = {P[tb[0]], P[tb[1]], P[tb[2]]};
-      const uint32_t ia[3] = {ta[0], ta[1], ta[2]};
-      const uint32_t ib[3] = {tb[0], tb[1], tb[2]};
-      if (!detail::triangles_intersect(pa, ia, pb, ib)) return;
-      count.fetch_add(1, std::memory_order_relaxed);
-      std::lock_guard lock(m);
-      examples.insert({std::min(fa, fb), std::max(fa, fb)});
-      if (examples.size() > cap) examples.erase(std::prev(examples.end()));
-    });
-    r.self_intersections = count.load();
-    r.self_intersections_checked = true;
-    std::vector<std::string> ex;
-    for (auto [a, b] : examples) ex.push_back("faces " + std::to_string(a) + " and " + std::to_string(b));
-    add_problem(r, r.self_intersections, "intersecting face pairs", ex);
+// 4. Global measures: components, area, Euler characteristic, volume.
+void global_measures(const Mesh& mesh, MeshCheck& r, UnionFind& faces) {
+  const auto& P = mesh.positions;
+  const auto& T = mesh.triangles;
+  size_t referenced = r.vertices - r.unreferenced_vertices;
+  size_t nf = 0;
+  for (size_t f = 0; f < T.size(); ++f) {
+    const Triangle& t = T[f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    ++nf;
+    if (faces.find(f) == f) ++r.components;
+    r.area += 0.5 * (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]).norm();
   }
+  r.euler = int64_t(referenced) - int64_t(r.edges) + int64_t(nf);
+  r.signed_volume = signed_volume(mesh);
+  if (r.closed() && r.manifold() && r.oriented() && r.faces > 0 && r.signed_volume < 0)
+    r.problems.push_back("inward orientation: the enclosed volume is negative (" + std::to_string(r.signed_volume) +
+                         ")");
+}
+
+// 5. Self-intersections (degenerate faces left out).
+void check_self_intersections(const Mesh& mesh, const MeshCheckOptions& options, const std::vector<uint8_t>& degenerate,
+                              MeshCheck& r) {
+  const auto& P = mesh.positions;
+  const auto& T = mesh.triangles;
+  const size_t cap = options.max_examples;
+  std::vector<detail::Aabb> boxes(T.size());
+  std::vector<uint32_t> ids;
+  for (size_t f = 0; f < T.size(); ++f) {
+    if (degenerate[f]) continue;
+    detail::Aabb b;
+    for (uint32_t v : T[f]) b.grow(P[v]);
+    boxes[ids.size()] = b;
+    ids.push_back(uint32_t(f));
+  }
+  boxes.resize(ids.size());
+  const detail::Bvh bvh(boxes);
+  std::atomic<size_t> count{0};
+  std::mutex m;
+  std::set<std::pair<uint32_t, uint32_t>> examples;  // the smallest pairs, deterministic
+  bvh.for_each_overlapping_pair([&](uint32_t a, uint32_t b) {
+    const uint32_t fa = ids[a], fb = ids[b];
+    const Triangle& ta = T[fa];
+    const Triangle& tb = T[fb];
+    const Vec3 pa[3] = {P[ta[0]], P[ta[1]], P[ta[2]]};
+    const Vec3 pb[3] = {P[tb[0]], P[tb[1]], P[tb[2]]};
+    const uint32_t ia[3] = {ta[0], ta[1], ta[2]};
+    const uint32_t ib[3] = {tb[0], tb[1], tb[2]};
+    if (!detail::triangles_intersect(pa, ia, pb, ib)) return;
+    count.fetch_add(1, std::memory_order_relaxed);
+    std::lock_guard lock(m);
+    examples.insert({std::min(fa, fb), std::max(fa, fb)});
+    if (examples.size() > cap) examples.erase(std::prev(examples.end()));
+  });
+  r.self_intersections = count.load();
+  r.self_intersections_checked = true;
+  std::vector<std::string> ex;
+  for (auto [a, b] : examples) ex.push_back("faces " + std::to_string(a) + " and " + std::to_string(b));
+  add_problem(r, r.self_intersections, "intersecting face pairs", ex);
+}
+
+}  // namespace
+
+MeshCheck check_mesh(const Mesh& mesh, const MeshCheckOptions& options) {
+  MeshCheck r;
+  r.vertices = mesh.positions.size();
+  r.faces = mesh.triangles.size();
+  if (!check_indices(mesh, options, r)) return r;
+  const std::vector<uint8_t> degenerate = check_degenerate(mesh, options, r);
+  UnionFind corners(3 * mesh.triangles.size());
+  UnionFind faces(mesh.triangles.size());
+  check_edges(mesh, options, r, corners, faces);
+  check_fans(mesh, options, r, corners);
+  global_measures(mesh, r, faces);
+  if (options.self_intersections && !mesh.triangles.empty()) check_self_intersections(mesh, options, degenerate, r);
   return r;
 }
 
