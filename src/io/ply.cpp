@@ -192,6 +192,19 @@ int parse_ply_header(const std::string& path, const std::string& text, std::vect
   return mode;
 }
 
+// One record of element e: its scalar properties into rec (lists read past).
+void read_record(const Element& e, Cursor& cur, std::vector<double>& rec) {
+  for (size_t k = 0; k < e.props.size(); ++k) {
+    const Property& p = e.props[k];
+    if (p.list) {
+      const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element '" + e.name + "'");
+      for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
+    } else {
+      rec[k] = cur.read(p.type);
+    }
+  }
+}
+
 // The vertex element: positions, and normals, colours and other scalar
 // properties when present.
 void read_ply_vertices(const std::string& path, const Element& e, Cursor& cur, uint64_t max_bytes, Mesh& m) {
@@ -219,15 +232,7 @@ void read_ply_vertices(const std::string& path, const Element& e, Cursor& cur, u
   for (int k : other) m.vertex_attributes.push_back({e.props[size_t(k)].name, to_scalar(e.props[size_t(k)].type), {}});
   std::vector<double> rec(e.props.size());
   for (uint64_t v = 0; v < e.count; ++v) {
-    for (size_t k = 0; k < e.props.size(); ++k) {
-      const Property& p = e.props[k];
-      if (p.list) {
-        const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'vertex'");
-        for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
-      } else {
-        rec[k] = cur.read(p.type);
-      }
-    }
+    read_record(e, cur, rec);
     m.positions[v] = Vec3(rec[size_t(ix)], rec[size_t(iy)], rec[size_t(iz)]);
     if (normals) m.normals[v] = Vec3(rec[size_t(inx)], rec[size_t(iny)], rec[size_t(inz)]);
     if (colors) {
@@ -296,15 +301,7 @@ void read_ply_edges(const std::string& path, const Element& e, Cursor& cur, uint
   check_limit(path, e.count * 8, max_bytes, "the edges");
   std::vector<double> rec(e.props.size());
   for (uint64_t r = 0; r < e.count; ++r) {
-    for (size_t k = 0; k < e.props.size(); ++k) {
-      const Property& p = e.props[k];
-      if (p.list) {
-        const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element 'edge'");
-        for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
-      } else {
-        rec[k] = cur.read(p.type);
-      }
-    }
+    read_record(e, cur, rec);
     if (i1 < 0 || i2 < 0) continue;
     const double a = rec[size_t(i1)], b = rec[size_t(i2)];
     if (!whole_in(a, 0, 4294967294.0) || !whole_in(b, 0, 4294967294.0))
@@ -315,15 +312,8 @@ void read_ply_edges(const std::string& path, const Element& e, Cursor& cur, uint
 
 // Any other element, read past.
 void skip_ply_element(const Element& e, Cursor& cur) {
-  for (uint64_t r = 0; r < e.count; ++r)
-    for (const Property& p : e.props) {
-      if (p.list) {
-        const uint64_t n = cur.length(p.count_type, 1e9, "invalid list length in element '" + e.name + "'");
-        for (uint64_t q = 0; q < n; ++q) cur.read(p.type);
-      } else {
-        cur.read(p.type);
-      }
-    }
+  std::vector<double> rec(e.props.size());
+  for (uint64_t r = 0; r < e.count; ++r) read_record(e, cur, rec);
 }
 
 }  // namespace
