@@ -190,12 +190,13 @@ class Lookahead {
 
   // The try of cell c, the first of `heap`'s next cells; `accepted`: the
   // flats accepted so far, `streak`: rejections since the last acceptance.
-  const Try& result_of(size_t c, const CellHeap& heap, size_t accepted, size_t streak) {
+  // The result leaves the look-ahead (each cell is tried once).
+  Try result_of(size_t c, const CellHeap& heap, size_t accepted, size_t streak) {
     if (tries_version_ != accepted) {
       tries_.clear();
       tries_version_ = accepted;
     }
-    if (const auto it = tries_.find(c); it != tries_.end()) return it->second;
+    if (auto node = tries_.extract(c)) return std::move(node.mapped());
     const std::vector<size_t> cells = next_cells(c, heap, streak);
     std::vector<Try> batch(cells.size());
     tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
@@ -210,8 +211,9 @@ class Lookahead {
       t.restabbed = d.restabbed - restabbed;
       t.refused_curved = d.refused_curved - refused;
     });
-    for (Try& t : batch) tries_.emplace(t.cell, std::move(t));
-    return tries_.at(c);
+    for (Try& t : batch)
+      if (t.cell != c) tries_.emplace(t.cell, std::move(t));
+    return std::move(batch.front());
   }
 
  private:
@@ -289,7 +291,7 @@ void extract_flats(FlatsContext& ctx, Votes& V, ProgressCounter& progress) {
     ++seg.stats.tried;
     cell_count[c] = 0;  // used: accepted or not, this cell is done
     if (!seeds_of(ctx, V, c, seeds)) continue;
-    const Try& tr = ahead.result_of(c, heap, accepted, streak);
+    const Try tr = ahead.result_of(c, heap, accepted, streak);
     const Plane& P = tr.P;
     const std::vector<uint32_t>& rejected = tr.rejected;
     const std::vector<uint32_t>& members = tr.members;
