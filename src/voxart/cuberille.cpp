@@ -56,52 +56,56 @@ std::vector<uint8_t> fill_solid(const ColorGrid& grid) {
   return solid;
 }
 
-QuadMesh solid_cuberille(const ColorGrid& grid) {
-  const std::vector<uint8_t> filled = fill_solid(grid);
-  const int64_t P[3] = {grid.dims[0] + 2, grid.dims[1] + 2, grid.dims[2] + 2};
-  const int64_t sx = 1, sy = P[0], sz = P[0] * P[1];
-  const uint64_t cells = uint64_t(P[0]) * uint64_t(P[1]) * uint64_t(P[2]);
-  auto padded = [&](int64_t i, int64_t j, int64_t k) { return i * sx + j * sy + k * sz; };
-  std::vector<uint8_t> outside(cells, 1);
-  for (int64_t k = 0; k < grid.dims[2]; ++k)
-    for (int64_t j = 0; j < grid.dims[1]; ++j)
-      for (int64_t i = 0; i < grid.dims[0]; ++i) outside[size_t(padded(i + 1, j + 1, k + 1))] = !filled[grid.index(i, j, k)];
-  QuadMesh out;
+namespace {
+
+// The cuberille of a solid (Section 4.2): the quads between its voxels and
+// the outside, over a grid padded by one voxel per side.
+class Cuberille {
+ public:
+  Cuberille(const ColorGrid& grid, const std::vector<uint8_t>& filled)
+      : grid_(grid), P{grid.dims[0] + 2, grid.dims[1] + 2, grid.dims[2] + 2}, sy(P[0]), sz(P[0] * P[1]),
+        outside_(uint64_t(P[0]) * uint64_t(P[1]) * uint64_t(P[2]), 1), slot_(outside_.size(), kNone) {
+    for (int64_t k = 0; k < grid.dims[2]; ++k)
+      for (int64_t j = 0; j < grid.dims[1]; ++j)
+        for (int64_t i = 0; i < grid.dims[0]; ++i) outside_[size_t(padded(i + 1, j + 1, k + 1))] = !filled[grid.index(i, j, k)];
+  }
+
   // Faces: (cell, direction d = 2 * axis + (positive ? 1 : 0)).
   struct Face {
     int64_t cell;
     int dir;
   };
   std::vector<Face> faces;
-  std::vector<uint32_t> slot(cells, kNone);  // boundary cell -> index into slot_faces / 6
-  std::vector<uint32_t> slot_faces;
-  const int64_t step[6] = {-sx, sx, -sy, sy, -sz, sz};
-  for (int64_t k = 1; k + 1 < P[2]; ++k)
-    for (int64_t j = 1; j + 1 < P[1]; ++j)
-      for (int64_t i = 1; i + 1 < P[0]; ++i) {
-        const int64_t c = padded(i, j, k);
-        if (outside[size_t(c)]) continue;
-        if (!grid.filled(i - 1, j - 1, k - 1)) {
-          ++out.filled_cavities;
-          continue;  // an enclosed cavity voxel never touches the outside
-        }
-        for (int d = 0; d < 6; ++d) {
-          if (!outside[size_t(c + step[d])]) continue;
-          if (slot[size_t(c)] == kNone) {
-            slot[size_t(c)] = uint32_t(slot_faces.size() / 6);
-            slot_faces.resize(slot_faces.size() + 6, kNone);
+
+  // Every face between a solid voxel and the outside; returns the enclosed
+  // cavity voxels (filled, never touching the outside).
+  uint64_t find_faces() {
+    uint64_t cavities = 0;
+    for (int64_t k = 1; k + 1 < P[2]; ++k)
+      for (int64_t j = 1; j + 1 < P[1]; ++j)
+        for (int64_t i = 1; i + 1 < P[0]; ++i) {
+          const int64_t c = padded(i, j, k);
+          if (outside_[size_t(c)]) continue;
+          if (!grid_.filled(i - 1, j - 1, k - 1)) {
+            ++cavities;
+            continue;  // an enclosed cavity voxel never touches the outside
           }
-          slot_faces[6 * slot[size_t(c)] + size_t(d)] = uint32_t(faces.size());
-          faces.push_back({c, d});
+          for (int d = 0; d < 6; ++d) {
+            if (!outside_[size_t(c + step[d])]) continue;
+            if (slot_[size_t(c)] == kNone) {
+              slot_[size_t(c)] = uint32_t(slot_faces_.size() / 6);
+              slot_faces_.resize(slot_faces_.size() + 6, kNone);
+            }
+            slot_faces_[6 * slot_[size_t(c)] + size_t(d)] = uint32_t(faces.size());
+            faces.push_back({c, d});
+          }
         }
-      }
-  if (faces.empty()) throw InputError(grid.name, "the part holds no voxel");
-  if (faces.size() > (size_t(1) << 29)) throw LimitError(grid.name, "too many voxel faces for one mesh");
-  auto solid = [&](int64_t c) { return !outside[size_t(c)]; };
-  auto face_id = [&](int64_t cell, int dir) { return slot_faces[6 * slot[size_t(cell)] + size_t(dir)]; };
+    return cavities;
+  }
+
   // Corner q of a face: lattice point (padded coordinates), counter-clockwise
   // seen from outside.
-  auto corner = [&](const Face& f, int q) {
+  std::array<int64_t, 3> corner(const Face& f, int q) const {
     const int a = f.dir / 2, u = (a + 1) % 3, v = (a + 2) % 3;
     static const int ccw[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, cw[4][2] = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
     const int(*order)[2] = f.dir % 2 ? ccw : cw;
@@ -110,26 +114,25 @@ QuadMesh solid_cuberille(const ColorGrid& grid) {
     p[size_t(u)] += order[q][0];
     p[size_t(v)] += order[q][1];
     return p;
-  };
-  // Corners joined across each edge. Going around the edge from a face, the
-  // next face is the one bounding the same outside voxel: concave (the voxel
-  // diagonal to ours across the edge is solid), flat (the voxel beside ours
-  // is), or convex (our own next face). Where two solid voxels meet only
-  // along the edge, that joins them (18-connected solids) unless the edge is
-  // marked `separate`, where each voxel keeps its own faces (6-connected).
-  // An edge whose two sheets end on the same vertices at both ends (four
-  // faces on one vertex pair) is marked separate and the pairing redone;
-  // edges that stay doubled either way are reported to the caller.
-  auto lattice_edge = [&](const std::array<int64_t, 3>& p0, const std::array<int64_t, 3>& p1) {
+  }
+
+  // The key of the lattice edge p0 p1.
+  int64_t lattice_edge(const std::array<int64_t, 3>& p0, const std::array<int64_t, 3>& p1) const {
     int axis = 0;
     while (p0[size_t(axis)] == p1[size_t(axis)]) ++axis;
     const auto& lo = p0[size_t(axis)] < p1[size_t(axis)] ? p0 : p1;
     return ((lo[2] * (P[1] + 1) + lo[1]) * (P[0] + 1) + lo[0]) * 3 + axis;
-  };
-  std::vector<int64_t> separate;  // sorted lattice edge keys
-  std::vector<uint32_t> parent(4 * faces.size()), id(parent.size());
-  std::vector<std::array<uint32_t, 3>> edge_use;  // (min vertex, max vertex, face) per quad edge
-  for (int round = 0;; ++round) {
+  }
+
+  // Corners joined across each edge (classes in `parent`, 4 per face).
+  // Going around the edge from a face, the next face is the one bounding
+  // the same outside voxel: concave (the voxel diagonal to ours across the
+  // edge is solid), flat (the voxel beside ours is), or convex (our own
+  // next face). Where two solid voxels meet only along the edge, that joins
+  // them (18-connected solids) unless the edge is in `separate` (sorted),
+  // where each voxel keeps its own faces (6-connected).
+  void join_corners(const std::vector<int64_t>& separate, std::vector<uint32_t>& parent) const {
+    const auto solid = [&](int64_t c) { return !outside_[size_t(c)]; };
     for (uint32_t x = 0; x < parent.size(); ++x) parent[x] = x;
     for (uint32_t fi = 0; fi < faces.size(); ++fi) {
       const Face& f = faces[fi];
@@ -167,7 +170,39 @@ QuadMesh solid_cuberille(const ColorGrid& grid) {
         }
       }
     }
-    // One vertex per class, numbered in order of first use.
+  }
+
+ private:
+  int64_t padded(int64_t i, int64_t j, int64_t k) const { return i + j * sy + k * sz; }
+  uint32_t face_id(int64_t cell, int dir) const { return slot_faces_[6 * slot_[size_t(cell)] + size_t(dir)]; }
+
+  const ColorGrid& grid_;
+  const int64_t P[3];
+  const int64_t sy, sz;
+  const int64_t step[6] = {-1, 1, -sy, sy, -sz, sz};
+  std::vector<uint8_t> outside_;
+  std::vector<uint32_t> slot_;  // boundary cell -> index into slot_faces_ / 6
+  std::vector<uint32_t> slot_faces_;
+};
+
+}  // namespace
+
+QuadMesh solid_cuberille(const ColorGrid& grid) {
+  Cuberille cb(grid, fill_solid(grid));
+  QuadMesh out;
+  out.filled_cavities = cb.find_faces();
+  const auto& faces = cb.faces;
+  if (faces.empty()) throw InputError(grid.name, "the part holds no voxel");
+  if (faces.size() > (size_t(1) << 29)) throw LimitError(grid.name, "too many voxel faces for one mesh");
+  const int64_t sy = grid.dims[0] + 2, sz = sy * (grid.dims[1] + 2);
+  // An edge whose two sheets end on the same vertices at both ends (four
+  // faces on one vertex pair) is marked separate and the pairing redone;
+  // edges that stay doubled either way are reported to the caller.
+  std::vector<int64_t> separate;  // sorted lattice edge keys
+  std::vector<uint32_t> parent(4 * faces.size()), id(parent.size());
+  std::vector<std::array<uint32_t, 3>> edge_use;  // (min vertex, max vertex, face) per quad edge
+  for (int round = 0;; ++round) {
+    cb.join_corners(separate, parent);
     uint32_t count = 0;
     std::fill(id.begin(), id.end(), kNone);
     for (uint32_t x = 0; x < parent.size(); ++x) {
@@ -188,7 +223,7 @@ QuadMesh solid_cuberille(const ColorGrid& grid) {
       }
       if (j - i > 2) {
         const uint32_t fi = edge_use[i][2] / 4, q = edge_use[i][2] % 4;
-        doubled.push_back(lattice_edge(corner(faces[fi], int(q)), corner(faces[fi], int((q + 1) % 4))));
+        doubled.push_back(cb.lattice_edge(cb.corner(faces[fi], int(q)), cb.corner(faces[fi], int((q + 1) % 4))));
       }
     }
     if (doubled.empty()) break;
@@ -208,11 +243,11 @@ QuadMesh solid_cuberille(const ColorGrid& grid) {
   out.centers.resize(faces.size());
   std::vector<std::array<int64_t, 3>> lattice;
   for (uint32_t fi = 0; fi < faces.size(); ++fi) {
-    const Face& f = faces[fi];
+    const Cuberille::Face& f = faces[fi];
     Vec3 centre = Vec3::Zero();
     for (int q = 0; q < 4; ++q) {
       const uint32_t v = id[4 * fi + uint32_t(q)];
-      const auto p = corner(f, q);
+      const auto p = cb.corner(f, q);
       const Vec3 x(double(p[0] - 1), double(p[1] - 1), double(p[2] - 1));
       if (v == out.positions.size()) {
         out.positions.push_back(x);
