@@ -37,10 +37,10 @@ std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
 // The first estimate's press: the final press's schedule (its stages by
 // extent, `levels`), so that without flats the estimate is the final press
 // at every size (a 256^3 sphere: one 100-sweep press instead of two). Its
-// sweeps are fixed: the flats do not depend on po.iterations. (With 2
-// stages at every size, as before: the same faces and no spurious flat on
-// the CAD part, boxes and fandisk at 256^3, r->t within 2 %;
-// docs/BENCHMARKS.md, The flats' estimates.)
+// sweeps are fixed: the flats do not depend on po.iterations. Against the
+// 2 stages it used to run at every size: the same faces and no spurious
+// flat on the CAD part, boxes and fandisk at 256^3, r->t within 2 %
+// (docs/BENCHMARKS.md, The flats' estimates).
 PressOptions estimate_options(const PressOptions& po, int levels) {
   PressOptions eo = po;
   eo.iterations = detail::kEstimateIterations;
