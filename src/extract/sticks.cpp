@@ -192,14 +192,6 @@ uint64_t stick_key(const std::array<int64_t, 3>& dims, const std::array<int64_t,
   return ((uint64_t(pl[2]) * py + uint64_t(pl[1])) * 3 + uint64_t(axis)) * px + uint64_t(pl[0]);
 }
 
-uint64_t count_sticks(const BinaryVolume& volume) {
-  const Padded pv(volume);
-  const auto info = classify_rows(pv, nullptr);
-  uint64_t n = 0;
-  for (const RowInfo& r : info) n += uint64_t(r.count[0]) + r.count[1] + r.count[2];
-  return n;
-}
-
 namespace {
 
 // Scan: each row's first stick id; the total.
@@ -396,6 +388,11 @@ void fill_triangles(const CellRows& rows, int64_t cell_rows_y, const std::vector
 }
 
 }  // namespace
+
+uint64_t count_sticks(const BinaryVolume& volume) {
+  std::vector<RowInfo> info = classify_rows(Padded(volume), nullptr);
+  return number_sticks(info);
+}
 
 StickSurface extract_sticks(const BinaryVolume& volume, const ExtractOptions& options, ExtractStats* stats) {
   const auto& dims = volume.lattice.dims;

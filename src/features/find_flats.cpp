@@ -183,7 +183,7 @@ class Lookahead {
       : ctx_(ctx), V_(V),
         threads_(std::min(size_t(tbb::this_task_arena::max_concurrency()),
                           tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
-        taken_(ctx.n, 0), detectors_([&ctx] {
+        detectors_([&ctx] {
           return Detector{ctx.S, ctx.o, ctx.seg.region, std::vector<uint32_t>(ctx.n, 0), 0, ctx.cos_cone,
                           std::vector<uint8_t>(ctx.n, 0)};
         }) {}
@@ -230,6 +230,7 @@ class Lookahead {
     // rejection there does not lower their counts, so the loop pops them
     // before the next acceptance (a neighbouring cell's often falls below
     // the seed share and its try would be wasted).
+    if (taken_.empty()) taken_.assign(ctx_.n, 0);  // only where batches run
     const uint32_t stamp = ++stamp_;
     const auto disjoint = [&](size_t c) {
       for (uint32_t i = V_.cell_begin[c]; i < V_.cell_begin[c + 1]; ++i)

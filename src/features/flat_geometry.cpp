@@ -78,7 +78,6 @@ class MinNorm {
   std::vector<uint32_t> order_;
 };
 
-
 // ---------------------------------------------------------------- directions
 // Equal-angle cube map: face (axis a, sign), the two other coordinates
 // divided by |d_a| and mapped through atan, so cells span equal angles along

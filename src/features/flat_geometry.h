@@ -151,7 +151,6 @@ double crossing(const Surface& S, size_t v, const Plane& P, double margin);
 double feasible_step(const Surface& S, const std::vector<uint32_t>& cluster, const Plane& P0, const Plane& P1,
                      double m);
 
-
 // A sample a plane must leave strictly on one side (crease_refit).
 
 struct SideConstraint {

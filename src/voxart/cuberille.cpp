@@ -103,13 +103,16 @@ class Cuberille {
     return cavities;
   }
 
+  // The padded coordinates of a cell.
+  std::array<int64_t, 3> coords(int64_t cell) const { return {cell % sy, (cell % sz) / sy, cell / sz}; }
+
   // Corner q of a face: lattice point (padded coordinates), counter-clockwise
   // seen from outside.
   std::array<int64_t, 3> corner(const Face& f, int q) const {
     const int a = f.dir / 2, u = (a + 1) % 3, v = (a + 2) % 3;
     static const int ccw[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, cw[4][2] = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
     const int(*order)[2] = f.dir % 2 ? ccw : cw;
-    std::array<int64_t, 3> p{f.cell % sy, (f.cell % sz) / sy, f.cell / sz};
+    std::array<int64_t, 3> p = coords(f.cell);
     p[size_t(a)] += f.dir % 2;
     p[size_t(u)] += order[q][0];
     p[size_t(v)] += order[q][1];
@@ -145,7 +148,7 @@ class Cuberille {
         int tdir = -1;
         for (int b = 0; b < 3; ++b) {
           if (b == f.dir / 2 || p0[size_t(b)] != p1[size_t(b)]) continue;
-          const int64_t base = b == 0 ? f.cell % sy : b == 1 ? (f.cell % sz) / sy : f.cell / sz;
+          const int64_t base = coords(f.cell)[size_t(b)];
           tdir = 2 * b + (p0[size_t(b)] > base ? 1 : 0);
         }
         const int64_t n = step[f.dir], t = step[tdir];
@@ -194,7 +197,6 @@ QuadMesh solid_cuberille(const ColorGrid& grid) {
   const auto& faces = cb.faces;
   if (faces.empty()) throw InputError(grid.name, "the part holds no voxel");
   if (faces.size() > (size_t(1) << 29)) throw LimitError(grid.name, "too many voxel faces for one mesh");
-  const int64_t sy = grid.dims[0] + 2, sz = sy * (grid.dims[1] + 2);
   // An edge whose two sheets end on the same vertices at both ends (four
   // faces on one vertex pair) is marked separate and the pairing redone;
   // edges that stay doubled either way are reported to the caller.
@@ -257,7 +259,7 @@ QuadMesh solid_cuberille(const ColorGrid& grid) {
       centre += x;
     }
     out.centers[fi] = centre / 4;
-    const int64_t i = f.cell % sy, j = (f.cell % sz) / sy, k = f.cell / sz;
+    const auto [i, j, k] = cb.coords(f.cell);
     out.colors[fi] = grid.voxels[grid.index(i - 1, j - 1, k - 1)];
   }
   std::sort(lattice.begin(), lattice.end());
