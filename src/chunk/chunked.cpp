@@ -2,8 +2,6 @@
 // global stick key. Theory of operation: include/voxpress/chunk/chunked.h.
 #include "voxpress/chunk/chunked.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -15,6 +13,7 @@
 
 #include "core/timing.h"
 #include "voxpress/core/error.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -290,7 +289,7 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
   out.code.resize(n);
   out.t.resize(n);
   std::vector<uint64_t> keys(n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(n, 1 << 14, [&](detail::IndexRange r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const Ref& ref = refs[i];
       const auto d = codec.decode(ref.key);
@@ -317,13 +316,13 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
     for (const SurfacePiece& p : pieces)
       for (size_t i = 0; i + 2 < p.triangles.size(); i += 3, ++w) first[w] = p.triangles.data() + i;
   }
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(m, 1 << 14, [&](detail::IndexRange r) {
     for (size_t i = r.begin(); i < r.end(); ++i) order[i] = {cube_of(codec, first[i]), i};
   });
   tbb::parallel_sort(order.begin(), order.end());
   out.triangles.resize(m);
   std::atomic<bool> missing{false};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(m, 1 << 14, [&](detail::IndexRange r) {
     for (size_t i = r.begin(); i < r.end(); ++i)
       for (int v = 0; v < 3; ++v) {
         const uint64_t key = first[order[i].at][v];
@@ -355,7 +354,7 @@ SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, c
   {
     std::mutex mu;
     ProgressCounter progress(options.progress, "summary", grid.count());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.count(), 1), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(grid.count(), 1, [&](detail::IndexRange r) {
       for (size_t b = r.begin(); b < r.end(); ++b) {
         const Box core = grid.core(b);
         VolumeSummary part;
@@ -380,7 +379,7 @@ SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, c
   std::vector<SurfacePiece> pieces(grid.count());
   {
     ProgressCounter progress(options.progress, "blocks", grid.count());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.count(), 1), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(grid.count(), 1, [&](detail::IndexRange r) {
       for (size_t b = r.begin(); b < r.end(); ++b) {
         const Box box = grid.with_halo(b);
         BinaryVolume block = read(box);

@@ -2,13 +2,13 @@
 // Theory of operation: include/voxpress/chunk/chunked_labels.h.
 #include "voxpress/chunk/chunked_labels.h"
 
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <exception>
 
 #include "core/timing.h"
 #include "voxpress/core/error.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -29,7 +29,7 @@ ChunkedLabels extract_labels_chunked(const ScalarVolume& header, const BoxRead& 
   std::vector<std::exception_ptr> failed(grid.count());
   {
     ProgressCounter counter(progress, "blocks", grid.count());
-    tbb::parallel_for(size_t(0), grid.count(), [&](size_t b) {
+    detail::parallel_for(grid.count(), [&](size_t b) {
       try {
         const Box box = grid.with_halo(b), core = grid.core(b);
         ScalarVolume samples = read(box);

@@ -105,11 +105,11 @@ void Bvh::traverse(uint32_t a0, uint32_t b0, F& f) const {
 
 }  // namespace voxpress::detail
 
-#include <tbb/parallel_for.h>
+#include "core/parallel.h"
 
 template <class F>
 void voxpress::detail::Bvh::for_each_overlapping_pair(F&& f) const {
   if (nodes_.empty()) return;
   const auto tasks = pair_tasks();
-  tbb::parallel_for(size_t(0), tasks.size(), [&](size_t t) { traverse(tasks[t].first, tasks[t].second, f); });
+  detail::parallel_for(tasks.size(), [&](size_t t) { traverse(tasks[t].first, tasks[t].second, f); });
 }

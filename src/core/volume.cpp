@@ -1,7 +1,6 @@
 #include "voxpress/core/volume.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include <unordered_map>
 
 #include "voxpress/core/error.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -91,7 +91,7 @@ BinaryVolume select(const ScalarVolume& v, int64_t component, Pred pred) {
   b.inside.resize(n);
   const int64_t stride = v.components;
   v.visit([&](auto values) {
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, n, 1 << 16), [&](const tbb::blocked_range<uint64_t>& r) {
+    detail::parallel_ranges(n, 1 << 16, [&](detail::IndexRange r) {
       for (uint64_t s = r.begin(); s < r.end(); ++s)
         b.inside[s] = pred(double(values[s * uint64_t(stride) + uint64_t(component)])) ? 1 : 0;
     });

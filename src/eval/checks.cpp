@@ -16,7 +16,6 @@
 // the surface is a violation.
 #include "voxpress/eval/checks.h"
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <Eigen/LU>
@@ -30,6 +29,7 @@
 #include "../core/bvh.h"
 #include "../core/predicates.h"
 #include "row_rays.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -293,7 +293,7 @@ void classify_planes(const detail::RowRays& rays, const ClassificationOptions& o
                      const std::array<int64_t, 3>& hi, int64_t k0, int64_t k1, const BinaryVolume& slab,
                      int64_t slab_k0, ProgressCounter& progress, std::atomic<uint64_t>* tally, std::mutex& m,
                      std::vector<std::array<int64_t, 3>>& examples) {
-  tbb::parallel_for(k0, k1, [&](int64_t k) {
+  detail::parallel_for(k0, k1, [&](int64_t k) {
     std::vector<int> winding;
     std::vector<uint8_t> odd;
     std::vector<int64_t> on_surface;

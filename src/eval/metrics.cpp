@@ -9,7 +9,6 @@
 // chunk order, so the figures are identical for any thread count.
 #include "voxpress/eval/metrics.h"
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <Eigen/LU>
@@ -19,6 +18,7 @@
 #include <numbers>
 
 #include "mesh_query.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -71,7 +71,7 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3>& points) {
   }
   const Vec3 ext = (hi - lo).cwiseMax(1e-300);
   std::vector<std::pair<uint64_t, uint32_t>> key(points.size());
-  tbb::parallel_for(size_t(0), points.size(), [&](size_t i) {
+  detail::parallel_for(points.size(), [&](size_t i) {
     const Vec3 u = ((points[i] - lo).cwiseQuotient(ext) * 2097151.0).cwiseMax(0.0).cwiseMin(2097151.0);
     key[i] = {spread(uint64_t(u.x())) | spread(uint64_t(u.y())) << 1 | spread(uint64_t(u.z())) << 2, uint32_t(i)};
   });
@@ -85,7 +85,7 @@ std::vector<uint32_t> morton_order(const std::vector<Vec3>& points) {
 template <class F>
 void chunked(size_t n, size_t chunk, F&& f) {
   const size_t chunks = (n + chunk - 1) / chunk;
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) { f(c * chunk, std::min(n, (c + 1) * chunk), c); });
+  detail::parallel_for(chunks, [&](size_t c) { f(c * chunk, std::min(n, (c + 1) * chunk), c); });
 }
 
 constexpr size_t kChunk = 4096;
@@ -145,7 +145,7 @@ void measure_result_to_truth(const Mesh& result, const Truth& truth, const detai
   const size_t n = result.triangles.empty() ? 0 : o.samples;
   std::vector<Vec3> pts(n);
   std::vector<uint32_t> face(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+  detail::parallel_for(n, [&](size_t i) {
     const auto s = result_query.sample(o.seed, i);
     pts[i] = s.point;
     face[i] = s.face;
@@ -241,7 +241,7 @@ void measure_truth_to_result(const Mesh& result, const Truth& truth, const detai
   auto vox = [&](const Vec3& d) { return vox_length(to_index, d); };
   const size_t n = result.triangles.empty() ? 0 : o.samples;
   std::vector<Vec3> pts(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) { pts[i] = truth.sample(o.seed + 7919, i).point; });
+  detail::parallel_for(n, [&](size_t i) { pts[i] = truth.sample(o.seed + 7919, i).point; });
   const std::vector<uint32_t> order = morton_order(pts);
   const size_t nchunks = (n + kChunk - 1) / kChunk;
   std::vector<Acc> phys(nchunks), voxs(nchunks);
@@ -281,7 +281,7 @@ void directed_sharp_distance(const std::vector<std::array<Vec3, 2>>& from, const
     }
   }
   std::vector<double> dp(pts.size()), dv(pts.size());
-  tbb::parallel_for(size_t(0), pts.size(), [&](size_t i) {
+  detail::parallel_for(pts.size(), [&](size_t i) {
     const Vec3 diff = closest_on_segments(pts[i], to) - pts[i];
     dp[i] = diff.norm();
     dv[i] = vox(diff);

@@ -1,6 +1,5 @@
 #include "voxpress/eval/shapes.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <map>
@@ -10,6 +9,7 @@
 
 #include "voxpress/core/error.h"
 #include "voxpress/eval/voxelize.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -194,7 +194,7 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
     g.volume.inside.resize(L.size());
     const Mat3 to_model = g.linear.inverse();
     ProgressCounter progress(o.progress, "sampling", uint64_t(L.dims[2]));
-    tbb::parallel_for(int64_t(0), L.dims[2], [&](int64_t k) {
+    detail::parallel_for(int64_t(0), L.dims[2], [&](int64_t k) {
       for (int64_t j = 0; j < L.dims[1]; ++j)
         for (int64_t i = 0; i < L.dims[0]; ++i) {
           const Vec3 p = L.to_physical(Vec3(double(i), double(j), double(k)));

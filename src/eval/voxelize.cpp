@@ -1,6 +1,5 @@
 #include "voxpress/eval/voxelize.h"
 
-#include <tbb/parallel_for.h>
 
 #include <Eigen/LU>
 #include <cmath>
@@ -9,6 +8,7 @@
 #include "voxpress/core/error.h"
 #include "voxpress/core/memory_budget.h"
 #include "voxpress/eval/checks.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -53,7 +53,7 @@ BinaryVolume voxelize_on(const Mesh& mesh, const Lattice& L, Progress* progress)
   const std::array<int64_t, 3> lo{0, 0, 0}, hi{L.dims[0] - 1, L.dims[1] - 1, L.dims[2] - 1};
   const detail::RowRays rays(std::move(V), mesh.triangles, lo, hi, L.flips_orientation());
   ProgressCounter counter(progress, "voxelizing", uint64_t(L.dims[2]));
-  tbb::parallel_for(int64_t(0), L.dims[2], [&](int64_t k) {
+  detail::parallel_for(int64_t(0), L.dims[2], [&](int64_t k) {
     std::vector<int> winding;
     std::vector<uint8_t> odd;
     std::vector<int64_t> on_surface;

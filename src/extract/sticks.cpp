@@ -23,8 +23,6 @@
 
 #include "extract/stick_box.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -35,6 +33,7 @@
 #include "voxpress/core/error.h"
 #include "voxpress/core/memory_budget.h"
 #include "voxpress/extract/cube_cases.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -111,19 +110,17 @@ void row_pass(const Padded& pv, int64_t q, int64_t r, RowInfo& info) {
 
 template <class F>
 void parallel_rows(int64_t rows, F&& f) {
-  tbb::parallel_for(tbb::blocked_range<int64_t>(0, rows, 16), [&](const tbb::blocked_range<int64_t>& range) {
-    for (int64_t row = range.begin(); row < range.end(); ++row) f(row);
+  detail::parallel_ranges(size_t(rows), 16, [&](detail::IndexRange range) {
+    for (size_t row = range.begin(); row < range.end(); ++row) f(int64_t(row));
   });
 }
 
 std::vector<RowInfo> classify_rows(const Padded& pv, ProgressCounter* progress) {
   const int64_t rows = pv.rows_y() * pv.rows_z();
   std::vector<RowInfo> info(static_cast<size_t>(rows));
-  tbb::parallel_for(tbb::blocked_range<int64_t>(0, pv.rows_z(), 1), [&](const tbb::blocked_range<int64_t>& range) {
-    for (int64_t r = range.begin(); r < range.end(); ++r) {
-      for (int64_t q = 0; q < pv.rows_y(); ++q) row_pass(pv, q, r, info[size_t(r * pv.rows_y() + q)]);
-      if (progress) progress->add(1);
-    }
+  detail::parallel_for(int64_t(0), pv.rows_z(), [&](int64_t r) {
+    for (int64_t q = 0; q < pv.rows_y(); ++q) row_pass(pv, q, r, info[size_t(r * pv.rows_y() + q)]);
+    if (progress) progress->add(1);
   });
   return info;
 }
@@ -145,7 +142,7 @@ StickSurface moved_to(StickSurface s, const Lattice& to, const std::array<int64_
   s.lattice = to;
   for (size_t a = 0; a < 3; ++a) s.padded[a] = to.dims[a] + 2;
   const uint64_t px = uint64_t(s.padded[0]), py = uint64_t(s.padded[1]);
-  tbb::parallel_for(size_t(0), s.stick_count(), [&](size_t i) {
+  detail::parallel_for(s.stick_count(), [&](size_t i) {
     const uint64_t l = s.lower[i];
     const uint64_t x = uint64_t(int64_t(l % ox) - at[0]), y = uint64_t(int64_t((l / ox) % oy) - at[1]),
                    z = uint64_t(int64_t(l / (ox * oy)) - at[2]);
@@ -322,15 +319,13 @@ uint64_t count_triangles(const CellRows& rows, int64_t cell_rows_y, int64_t cell
                          const ExtractOptions& options) {
   const CubeCase* const table = &cube_case(0);
   ProgressCounter progress(options.progress, "triangles", uint64_t(cell_rows_z));
-  tbb::parallel_for(tbb::blocked_range<int64_t>(0, cell_rows_z, 1), [&](const tbb::blocked_range<int64_t>& range) {
-    for (int64_t r = range.begin(); r < range.end(); ++r) {
-      for (int64_t q = 0; q < cell_rows_y; ++q) {
-        CellRow& cr = cells[size_t(r * cell_rows_y + q)];
-        if (!rows.prepare(q, r, cr)) continue;
-        rows.walk(q, r, cr, [&](int64_t, unsigned mask, unsigned, unsigned) { cr.count += table[mask].count; });
-      }
-      progress.add(1);
+  detail::parallel_for(int64_t(0), cell_rows_z, [&](int64_t r) {
+    for (int64_t q = 0; q < cell_rows_y; ++q) {
+      CellRow& cr = cells[size_t(r * cell_rows_y + q)];
+      if (!rows.prepare(q, r, cr)) continue;
+      rows.walk(q, r, cr, [&](int64_t, unsigned mask, unsigned, unsigned) { cr.count += table[mask].count; });
     }
+    progress.add(1);
   });
   uint64_t ntri = 0;
   for (CellRow& cr : cells) {
@@ -441,7 +436,7 @@ Mesh to_mesh(const StickSurface& s) {
   m.positions.resize(s.stick_count());
   const Mat3 M = s.lattice.index_to_physical_matrix();
   const Vec3 o = s.lattice.origin;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.stick_count(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(s.stick_count(), 1 << 14, [&](detail::IndexRange r) {
     for (size_t i = r.begin(); i < r.end(); ++i) m.positions[i] = o + M * s.index_position(i);
   });
   m.triangles = s.triangles;

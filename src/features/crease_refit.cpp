@@ -2,9 +2,7 @@
 // and include/voxpress/features/flats.h.
 #include "flat_geometry.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
@@ -19,6 +17,7 @@
 #include <numbers>
 #include <queue>
 #include <tuple>
+#include "core/parallel.h"
 
 namespace voxpress::flats_impl {
 
@@ -116,7 +115,7 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
       sc.broken.assign(F, 0);
       return sc;
     });
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(n), 1024), [&](const tbb::blocked_range<uint32_t>& r) {
+    detail::parallel_ranges(uint32_t(n), 1024, [&](detail::IndexRange r) {
       Scratch& sc = scratch.local();
       for (uint32_t v = r.begin(); v < r.end(); ++v)
         if ((seg.region[v] >= 0 || seg.junction[v]) && depth[v] != detail::kUnreached) gather(v, sc);

@@ -1,9 +1,7 @@
 // Beyond the paper: the fresh vertices next to a sharp flat border placed by
 // the curved side's own surface, extrapolated up to the flat. Theory of
 // operation: include/voxpress/features/flats.h (fit_creases).
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +13,7 @@
 #include "smooth/stick_solid.h"
 #include "smooth/surface_graph.h"
 #include "voxpress/features/flats.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -58,7 +57,7 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
     if (dist[v] <= R) members.push_back(uint32_t(v));
   std::vector<double> t_new(members.size(), std::numeric_limits<double>::quiet_NaN());
   tbb::enumerable_thread_specific<RingScratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(members.size(), 64, [&](detail::IndexRange r) {
     RingScratch& rs = scratch.local();
     std::vector<Vec3> pts;
     for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -118,7 +117,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
     if (band[v]) members.push_back(uint32_t(v));
   std::vector<CurvedCrease> found(members.size(), CurvedCrease{0, std::numeric_limits<double>::quiet_NaN(), {}, {}});
   tbb::enumerable_thread_specific<RingScratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, members.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(members.size(), 64, [&](detail::IndexRange r) {
     RingScratch& rs = scratch.local();
     std::vector<uint32_t> P;
     std::vector<uint8_t> side, keep;
@@ -279,7 +278,7 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
   std::vector<uint32_t> off, adj;
   detail::vertex_adjacency(n, s.triangles, off, adj);
   std::vector<Vec3> x(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
+  detail::parallel_for(n, [&](size_t v) { x[v] = s.index_position(v); });
   const detail::CreaseFit c{
       .rings = detail::kCreaseRings, .fit_rings = detail::kCreaseFitRings, .residual = detail::kCreaseResidual, .margin = o.margin};
   const auto targets = detail::crease_targets(s, seg.flats, seg.region, seg.junction, x, off, adj, c);
@@ -297,7 +296,7 @@ size_t fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const Fl
   std::vector<uint32_t> off, adj;
   detail::vertex_adjacency(n, s.triangles, off, adj);
   std::vector<Vec3> x(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) { x[v] = s.index_position(v); });
+  detail::parallel_for(n, [&](size_t v) { x[v] = s.index_position(v); });
   fixed.resize(n, 0);
   std::vector<uint8_t> role(n);
   for (size_t v = 0; v < n; ++v)

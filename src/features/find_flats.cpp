@@ -11,10 +11,8 @@
 #include "flat_geometry.h"
 #include "smooth/quadric.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/task_arena.h>
@@ -32,6 +30,7 @@
 #include <queue>
 #include <tuple>
 #include <unordered_map>
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -199,7 +198,7 @@ class Lookahead {
     if (auto node = tries_.extract(c)) return std::move(node.mapped());
     const std::vector<size_t> cells = next_cells(c, heap, streak);
     std::vector<Try> batch(cells.size());
-    tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
+    detail::parallel_for(cells.size(), [&](size_t k) {
       Try& t = batch[k];
       t.cell = cells[k];
       std::vector<uint32_t> own;

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -13,6 +12,7 @@
 
 #include "flat_geometry.h"
 #include "smooth/quadric.h"
+#include "core/parallel.h"
 
 namespace voxpress::flats_impl {
 
@@ -333,7 +333,7 @@ struct Detector {
       const double h = std::tan(step * kPi / 180);
       for (int i = 0; i < side; ++i)
         for (int j = 0; j < side; ++j) dir[size_t(i * side + j)] = (centre + (i - half) * h * u + (j - half) * h * v).normalized();
-      tbb::parallel_for(size_t(0), res.size(), [&](size_t k) { res[k] = sweep(dir[k]); });
+      detail::parallel_for(res.size(), [&](size_t k) { res[k] = sweep(dir[k]); });
       for (size_t k = 0; k < res.size(); ++k)  // fixed order: deterministic
         if (res[k].count > best.count) {
           best = res[k];

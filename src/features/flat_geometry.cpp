@@ -4,7 +4,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
@@ -19,6 +18,7 @@
 #include <numbers>
 #include <queue>
 #include <tuple>
+#include "core/parallel.h"
 
 namespace voxpress::flats_impl {
 
@@ -159,7 +159,7 @@ Votes cast_votes(const Surface& S, double cone) {
   // cone vote (curved regions then vote little).
   std::vector<uint64_t> keys(n * kMaxVotes);
   V.count.assign(n, 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(n, 4096, [&](detail::IndexRange r) {
     for (size_t v = r.begin(); v < r.end(); ++v) {
       bool planar = true;
       for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1] && planar; ++k)
@@ -188,7 +188,7 @@ Votes cast_votes(const Surface& S, double cone) {
         sorted[at[key >> 32]++] = (key << 32) | v;
       }
   }
-  tbb::parallel_for(size_t(0), kCells, [&](size_t c) {
+  detail::parallel_for(kCells, [&](size_t c) {
     std::sort(sorted.begin() + ptrdiff_t(bucket[c]), sorted.begin() + ptrdiff_t(bucket[c + 1]));
   });
   V.voter.resize(V.votes);
@@ -206,7 +206,7 @@ Votes cast_votes(const Surface& S, double cone) {
   V.cell_begin.push_back(uint32_t(V.votes));
   // Each vote's cell, by the voter's vote slot (unvoting's look-up).
   V.vote_cell.assign(n * kMaxVotes, 0);
-  tbb::parallel_for(size_t(0), V.cell_key.size(), [&](size_t c) {
+  detail::parallel_for(V.cell_key.size(), [&](size_t c) {
     for (uint32_t i = V.cell_begin[c]; i < V.cell_begin[c + 1]; ++i) {
       const uint32_t v = V.voter[i];
       for (uint32_t q = 0; q < V.count[v]; ++q)
@@ -365,7 +365,7 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
   S.s = &s;
   const size_t n = s.stick_count();
   S.x.resize(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     Vec3 p = s.sample_points(v)[0];
     p[s.axis(v)] += t[v];
     S.x[v] = p;
@@ -379,7 +379,7 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
       S.area[v] += c.norm() / 6;
     }
   }
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     const double l = S.nrm[v].norm();
     S.nrm[v] = l > 0 ? Vec3(S.nrm[v] / l) : Vec3(0, 0, 1);
   });
@@ -388,7 +388,7 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
   // staircase noise; averaging over a few rings brings them under one.
   std::vector<Vec3> next(n);
   for (int round = 0; round < kNormalRings; ++round) {
-    tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    detail::parallel_for(n, [&](size_t v) {
       Vec3 sum = S.nrm[v];
       for (uint32_t k = S.adj_off[v]; k < S.adj_off[v + 1]; ++k) sum += S.nrm[S.adj[k]];
       const double l = sum.norm();

@@ -8,9 +8,7 @@
 #include "flat_geometry.h"
 #include "smooth/quadric.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -18,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include "core/parallel.h"
 
 namespace voxpress::flats_impl {
 
@@ -152,7 +151,7 @@ void detect_junctions(FlatsContext& ctx) {
   std::fill(seg.junction.begin(), seg.junction.end(), 0);
   ctx.smooth_borders = 0;
   ctx.off_plane_junctions = 0;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, ctx.n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(ctx.n, 1024, [&](detail::IndexRange r) {
     std::vector<Vec3> pts;
     detail::RingScratch& rs = ctx.scratch.local();
     for (size_t v = r.begin(); v < r.end(); ++v) {
@@ -274,7 +273,7 @@ void release_rim(FlatsContext& ctx) {
   // The smooth borders that are tangent (in parallel; each test reads the
   // regions only).
   std::vector<uint8_t> is_tangent(borders.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, borders.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(borders.size(), 256, [&](detail::IndexRange r) {
     std::vector<Vec3> pts;
     detail::RingScratch& rs = ctx.scratch.local();
     for (size_t i = r.begin(); i < r.end(); ++i)

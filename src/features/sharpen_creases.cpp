@@ -1,6 +1,7 @@
 // Sharpening: thin walls, the final crease fit, vertices past their crease, curved creases.
 // Theory of operation: sharpener.h and include/voxpress/features/sharpen.h.
 #include "sharpener.h"
+#include "core/parallel.h"
 
 namespace voxpress::sharpen_impl {
 
@@ -130,7 +131,7 @@ void fit_wall_planes(const Sharpener& sh, const Walls& W, std::vector<Plane>& wa
   wall.assign(W.cand.size(), Plane{});
   ok.assign(W.cand.size(), 0);
   tbb::enumerable_thread_specific<detail::RingScratch> scratch;
-  tbb::parallel_for(size_t(0), W.cand.size(), [&](size_t k) {
+  detail::parallel_for(W.cand.size(), [&](size_t k) {
     const uint32_t v = W.cand[k];
     const auto [A, B] = W.pair[v];
     const Vec3 na = sh.seg.flats[size_t(A)].index_normal.normalized();

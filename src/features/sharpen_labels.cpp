@@ -1,6 +1,7 @@
 // Sharpening: the regions (leftovers, strips, snapped bands, junctions) and each side's plane.
 // Theory of operation: sharpener.h and include/voxpress/features/sharpen.h.
 #include "sharpener.h"
+#include "core/parallel.h"
 
 namespace voxpress::sharpen_impl {
 
@@ -104,7 +105,7 @@ void Sharpener::snap_to_flats() {
   std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
   std::vector<double> t(n, 0);
   tbb::enumerable_thread_specific<SnapScratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, uint32_t(n), 256), [&](const tbb::blocked_range<uint32_t>& r) {
+  detail::parallel_ranges(uint32_t(n), 256, [&](detail::IndexRange r) {
     SnapScratch& sc = scratch.local();
     for (uint32_t v = r.begin(); v < r.end(); ++v) {
       const bool member = seg.region[v] >= 0;

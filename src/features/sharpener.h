@@ -15,9 +15,7 @@
 #include <numeric>
 #include <unordered_map>
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include "core/clearance.h"
 #include "core/predicates.h"

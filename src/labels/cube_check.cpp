@@ -2,13 +2,13 @@
 // cube_check.h.
 #include "cube_check.h"
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/clearance.h"
+#include "core/parallel.h"
 
 namespace voxpress::detail {
 
@@ -16,7 +16,7 @@ Cubes cubes_of(const Mesh& m, const std::vector<Vec3>& x0, const std::vector<uin
   Cubes c;
   const size_t nt = m.triangles.size();
   std::vector<std::pair<std::array<int64_t, 3>, uint32_t>> key(nt);
-  tbb::parallel_for(size_t(0), nt, [&](size_t f) {
+  detail::parallel_for(nt, [&](size_t f) {
     const Triangle& t = m.triangles[f];
     const Vec3 g = (x0[t[0]] + x0[t[1]] + x0[t[2]]) / 3;
     key[f] = {{int64_t(std::floor(g[0])), int64_t(std::floor(g[1])), int64_t(std::floor(g[2]))}, uint32_t(f)};
@@ -64,7 +64,7 @@ bool cube_ok(const Mesh& m, const Cubes& c, uint32_t g, const std::vector<Vec3>&
 std::vector<uint32_t> failing_cubes(const Mesh& m, const Cubes& c, const std::vector<uint32_t>& groups,
                                     const std::vector<Vec3>& x, double delta) {
   std::vector<uint8_t> bad(groups.size(), 0);
-  tbb::parallel_for(size_t(0), groups.size(), [&](size_t k) { bad[k] = !cube_ok(m, c, groups[k], x, delta); });
+  detail::parallel_for(groups.size(), [&](size_t k) { bad[k] = !cube_ok(m, c, groups[k], x, delta); });
   std::vector<uint32_t> out;
   for (size_t k = 0; k < groups.size(); ++k)
     if (bad[k]) out.push_back(groups[k]);

@@ -2,12 +2,12 @@
 // label_view.h.
 #include "label_view.h"
 
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include "core/parallel.h"
 
 namespace voxpress::detail {
 namespace {
@@ -51,7 +51,7 @@ Ownership ownership(const SharedSurface& s, const std::vector<uint8_t>& takes_pa
   Ownership c;
   const size_t nt = s.mesh.triangles.size();
   c.tris.resize(nt);
-  tbb::parallel_for(size_t(0), nt, [&](size_t f) {
+  detail::parallel_for(nt, [&](size_t f) {
     const Triangle& t = s.mesh.triangles[f];
     c.tris[f] = {floor_of((element_centre(s, t[0]) + element_centre(s, t[1]) + element_centre(s, t[2])) / 3), uint32_t(f)};
   });
@@ -60,7 +60,7 @@ Ownership ownership(const SharedSurface& s, const std::vector<uint8_t>& takes_pa
     if (i == nt || c.tris[i].first != c.tris[i - 1].first) c.offsets.push_back(i);
   if (nt == 0) c.offsets.assign(1, 0);
   c.owner.assign(c.offsets.size() - 1, UINT32_MAX);
-  tbb::parallel_for(size_t(0), c.owner.size(), [&](size_t g) {
+  detail::parallel_for(c.owner.size(), [&](size_t g) {
     const auto pair = [&](size_t k) {
       const auto& sd = s.sides[c.tris[k].second];
       return std::array<uint32_t, 2>{std::min(sd[0], sd[1]), std::max(sd[0], sd[1])};

@@ -3,7 +3,6 @@
 // include/voxpress/labels/labels.h.
 #include "voxpress/labels/labels.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -16,6 +15,7 @@
 
 #include "../io/io_util.h"
 #include "voxpress/core/error.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -334,7 +334,7 @@ void mask_into(const ScalarVolume& v, const Box& box, const LabelInfo& label, Bi
   v.visit([&](auto values) {
     using T = typename decltype(values)::value_type;
     const T want = T(label.value);
-    tbb::parallel_for(int64_t(0), d[2], [&](int64_t k) {
+    detail::parallel_for(int64_t(0), d[2], [&](int64_t k) {
       for (int64_t j = 0; j < d[1]; ++j)
         for (int64_t i = 0; i < d[0]; ++i) {
           const uint64_t s = v.lattice.linear(box.lo[0] + i, box.lo[1] + j, box.lo[2] + k);
@@ -393,7 +393,7 @@ std::vector<LabelSurface> press_labels(const ScalarVolume& v, const std::vector<
   // Labels in parallel (each smooth_surface is itself parallel and gives the
   // same bytes for any thread count, so the results do not depend on the
   // schedule); the first failure in label order is the one reported.
-  tbb::parallel_for(size_t(0), labels.size(), [&](size_t i) {
+  detail::parallel_for(labels.size(), [&](size_t i) {
     try {
       out[i].label = labels[i];
       out[i].result = smooth_surface(label_mask(v, labels[i]), per);

@@ -2,13 +2,13 @@
 // the same arithmetic for any shift, pad or crop of the label map.
 #pragma once
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
 
 #include "voxpress/labels/shared_surface.h"
+#include "core/parallel.h"
 
 namespace voxpress::detail {
 
@@ -36,7 +36,7 @@ class OwnFrame {
 
  private:
   void shift(int64_t sign) {
-    tbb::parallel_for(size_t(0), s_.corner.size(), [&](size_t v) {
+    detail::parallel_for(s_.corner.size(), [&](size_t v) {
       for (size_t a = 0; a < 3; ++a) s_.corner[v][a] += sign * base_[a];
     });
   }

@@ -3,7 +3,6 @@
 // include/voxpress/labels/shared_fit.h.
 #include "voxpress/labels/shared_fit.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +11,7 @@
 #include "core/timing.h"
 #include "cube_check.h"
 #include "label_view.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -36,7 +36,7 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
   std::vector<Fit> fits(todo.size());
   const std::vector<int32_t> no_regions;
   const std::vector<uint8_t> no_junctions;
-  tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
+  detail::parallel_for(todo.size(), [&](size_t i) {
     const uint32_t l = todo[i];
     const LabelInfo& info = labels[info_of[l]];
     detail::LabelView v = detail::label_view(s, own, sticks, masks(info), detail::mask_origin(info.lo), l);
@@ -58,7 +58,7 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
   // Applied, then every cube with a moved vertex checked exactly.
   const size_t n = s.mesh.positions.size();
   std::vector<Vec3> x(n), x0(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     x[v] = s.lattice.to_index(s.mesh.positions[v]);
     x0[v] = detail::element_centre(s, v);
   });
@@ -86,7 +86,7 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
   const double delta = detail::float32_clearance_around(s.lattice, x);
   st.cubes_put_back = detail::put_back(s.mesh, cubes, detail::failing_cubes(s.mesh, cubes, touched, x, delta), x,
                                        back, reset, delta);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     if (!reset[v]) s.mesh.positions[v] = s.lattice.to_physical(x[v]);  // the others keep their bits
   });
   for (uint32_t v = 0; v < n; ++v) st.moved += !reset[v];

@@ -2,7 +2,6 @@
 // shared stick vertices. Theory of operation: include/voxpress/labels/shared_flats.h.
 #include "voxpress/labels/shared_flats.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -13,6 +12,7 @@
 #include "core/timing.h"
 #include "shared_sticks.h"
 #include "voxpress/labels/labels.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -53,7 +53,7 @@ SharedFlats find_shared_flats(const LabelMasks& masks, const SharedSurface& s, c
   po.progress = nullptr;
   if (progress) progress->begin("flats per label", labels.size());
   std::atomic<uint64_t> done{0};
-  tbb::parallel_for(size_t(0), labels.size(), [&](size_t i) {
+  detail::parallel_for(labels.size(), [&](size_t i) {
     const LabelInfo& label = labels[i];
     const BinaryVolume mask = masks(label);
     const std::array<int64_t, 3> lo = detail::mask_origin(label.lo);

@@ -4,7 +4,6 @@
 #include "voxpress/labels/shared_press.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
@@ -23,6 +22,7 @@
 #include "cube_check.h"
 #include "own_frame.h"
 #include "smooth/curve_kernel.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -52,7 +52,7 @@ struct Edge {
 
 std::vector<Edge> edges_of(const Mesh& m) {
   std::vector<uint64_t> keys(3 * m.triangles.size());
-  tbb::parallel_for(size_t(0), m.triangles.size(), [&](size_t f) {
+  detail::parallel_for(m.triangles.size(), [&](size_t f) {
     const Triangle& t = m.triangles[f];
     for (int e = 0; e < 3; ++e) {
       const uint32_t a = t[size_t(e)], b = t[size_t((e + 1) % 3)];
@@ -165,7 +165,7 @@ PressStats press_junctions(const SharedSurface& s, const Chains& c, const std::v
   for (int it = 0; it < sweeps; ++it) {
     const int stage = std::min(levels - 1, it * levels / std::max(sweeps, 1));
     const double d = o.arc_length * double(1 << (levels - 1 - stage)) * cell;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, c.closed.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(c.closed.size(), 16, [&](detail::IndexRange r) {
       detail::Scratch<Vec3> w;
       for (size_t k = r.begin(); k < r.end(); ++k) {
         const uint32_t b = c.offsets[k], n = c.offsets[k + 1] - b;
@@ -288,7 +288,7 @@ std::vector<uint8_t> flat_places(const SharedSurface& s, const SharedFlats& flat
   const Mat3 Mt = s.lattice.index_to_physical_matrix().transpose();
   std::vector<uint8_t> placed(n, 0);
   target.assign(n, Vec3::Zero());
-  tbb::parallel_for(size_t(0), members.size(), [&](size_t i) {
+  detail::parallel_for(members.size(), [&](size_t i) {
     const uint32_t v = members[i];
     std::vector<int32_t> regions;
     for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k)
@@ -472,7 +472,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   const detail::OwnFrame frame(s);
   std::vector<Vec3> x0(n);
   std::vector<double> t0s(n, 0);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     const uint8_t k = s.kind[v];
     x0[v] = Vec3(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
     for (int a = 0; a < 3; ++a)
@@ -548,7 +548,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
       if (on_flat[v] && !pinned[v]) t[v] = flats->t[v];
     }
     st.interfaces = detail::iterate(t, families, 2, frozen, barrier, o, levels);
-    tbb::parallel_for(size_t(0), n, [&](size_t v) {
+    detail::parallel_for(n, [&](size_t v) {
       if (!is_stick(s.kind[v]) || jg.degree(v) > 0) return;  // junction sticks stay where stage 1 put them
       Vec3 y(double(s.corner[v][0]), double(s.corner[v][1]), double(s.corner[v][2]));
       y[s.kind[v]] += t[v];
@@ -577,7 +577,7 @@ SharedPressStats press_shared(SharedSurface& s, const PressOptions& o, const Sha
   }
   std::vector<uint8_t> reset(n, 0);
   st.cubes_reset = detail::put_back(s.mesh, cubes, std::move(bad), x, x0, reset, delta);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     if (x[v] != x0[v]) s.mesh.positions[v] = s.lattice.to_physical(x[v]);  // the others keep their bits
   });
   s.mesh.normals.clear();

@@ -3,7 +3,6 @@
 // operation: include/voxpress/labels/shared_sharpen.h.
 #include "voxpress/labels/shared_sharpen.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +12,7 @@
 #include "core/timing.h"
 #include "features/sharpener.h"
 #include "label_view.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -193,7 +193,7 @@ std::vector<uint8_t> failing(const SharedSurface& s, const std::vector<Changed>&
   if (changed.empty()) return bad;
   const auto& tris = s.mesh.triangles;
   std::vector<Vec3> x(s.mesh.positions.size());
-  tbb::parallel_for(size_t(0), x.size(), [&](size_t v) { x[v] = s.lattice.to_index(s.mesh.positions[v]); });
+  detail::parallel_for(x.size(), [&](size_t v) { x[v] = s.lattice.to_index(s.mesh.positions[v]); });
   auto box = [&](uint32_t f, double grow) {
     const Triangle& t = tris[f];
     return std::pair<Vec3, Vec3>{x[t[0]].cwiseMin(x[t[1]]).cwiseMin(x[t[2]]).array() - grow,
@@ -219,7 +219,7 @@ std::vector<uint8_t> failing(const SharedSurface& s, const std::vector<Changed>&
       if (std::binary_search(near.begin(), near.end(), q)) in.push_back({q, f});
     });
   std::sort(in.begin(), in.end());
-  tbb::parallel_for(size_t(0), changed.size(), [&](size_t k) {
+  detail::parallel_for(changed.size(), [&](size_t k) {
     const uint32_t f = changed[k].f;
     const double d = delta(changed[k]);
     const Triangle& a = tris[f];
@@ -266,7 +266,7 @@ SharedSharpenStats sharpen_shared(SharedSurface& s, const SharedFlats& flats, co
   SharpenOptions o = options;
   o.progress = nullptr;
   std::vector<LabelEdit> edits(todo.size());
-  tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
+  detail::parallel_for(todo.size(), [&](size_t i) {
     const uint32_t l = todo[i];
     const LabelInfo& info = labels[info_of[l]];
     edits[i] = sharpen_label(detail::label_view(s, own, sticks, masks(info), detail::mask_origin(info.lo), l),

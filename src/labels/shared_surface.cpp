@@ -3,8 +3,6 @@
 // meet on the same stick and face vertices, then one sort of the keys.
 #include "voxpress/labels/shared_surface.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -17,6 +15,7 @@
 #include "voxpress/core/error.h"
 #include "voxpress/extract/cube_cases.h"
 #include "voxpress/labels/label_cases.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -57,7 +56,7 @@ SharedPiece extract_shared_piece(const ScalarVolume& volume, const Box& read, co
   // Sample labels, validated.
   std::vector<uint32_t> lab(volume.lattice.size());
   std::atomic<bool> bad{false};
-  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, lab.size(), 1 << 16), [&](const tbb::blocked_range<uint64_t>& r) {
+  detail::parallel_ranges(lab.size(), 1 << 16, [&](detail::IndexRange r) {
     for (uint64_t i = r.begin(); i < r.end(); ++i) {
       const double x = volume.value(i);
       if (!(x >= 0 && x <= 4294967295.0 && x == std::floor(x))) bad = true;
@@ -79,8 +78,8 @@ SharedPiece extract_shared_piece(const ScalarVolume& volume, const Box& read, co
     last[a] = core.hi[a];
   }
   std::vector<SharedPiece> layers(size_t(last[2] - first[2] + 1));
-  tbb::parallel_for(tbb::blocked_range<int64_t>(first[2], last[2] + 1, 1), [&](const tbb::blocked_range<int64_t>& rr) {
-    for (int64_t r = rr.begin(); r < rr.end(); ++r) {
+  detail::parallel_ranges(size_t(last[2] + 1 - first[2]), 1, [&](detail::IndexRange rr) {
+    for (int64_t r = first[2] + int64_t(rr.begin()); r < first[2] + int64_t(rr.end()); ++r) {
       SharedPiece& out = layers[size_t(r - first[2])];
       for (int64_t q = first[1]; q <= last[1]; ++q)
         for (int64_t p = first[0]; p <= last[0]; ++p) {
@@ -207,7 +206,7 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
   out.mesh.positions.resize(all.size());
   out.kind.resize(all.size());
   out.corner.resize(all.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, all.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(all.size(), 1 << 14, [&](detail::IndexRange r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const auto [s, kind] = keys.decode(all[i]);
       Vec3 x(double(s[0] - 1), double(s[1] - 1), double(s[2] - 1));
@@ -238,7 +237,7 @@ SharedSurface assemble_shared_surface(const Lattice& lattice, std::vector<Shared
   out.mesh.triangles.resize(m);
   out.sides.resize(m);
   const bool flip = lattice.flips_orientation();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, m, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(m, 1 << 14, [&](detail::IndexRange r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const auto [piece, at] = tri(i);
       Triangle t;

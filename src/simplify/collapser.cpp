@@ -4,7 +4,6 @@
 #include "simplify/collapser.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <Eigen/Dense>
@@ -17,6 +16,7 @@
 #include "core/clearance.h"
 #include "core/timing.h"
 #include "eval/mesh_query.h"
+#include "core/parallel.h"
 
 namespace voxpress::detail {
 
@@ -426,7 +426,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
   // Every edge's cheapest move, costed in parallel, in face order.
   std::vector<Entry> first(3 * tri.size());
   std::vector<uint8_t> has(first.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, tri.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(tri.size(), 1024, [&](detail::IndexRange r) {
     for (size_t f = r.begin(); f < r.end(); ++f)
       for (size_t c = 0; c < 3; ++c) {
         const uint32_t a = tri[f][c], b = tri[f][(c + 1) % 3];
@@ -455,7 +455,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
   std::vector<std::vector<Entry>> fresh;
   while (alive_faces > target && !heap.empty()) {
     const size_t n = select(heap, (alive_faces - target + 1) / 2);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(n, 1, [&](detail::IndexRange r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         Candidate& c = round_[i];
         c.accepted = -1;
@@ -498,7 +498,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     // neighbours are in its own move's neighbourhood, which no other move
     // of the round touched) and pushed in order.
     fresh.resize(kept.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, kept.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(kept.size(), 8, [&](detail::IndexRange r) {
       std::vector<uint32_t> nb;
       for (size_t i = r.begin(); i < r.end(); ++i) {
         const uint32_t v = kept[i];

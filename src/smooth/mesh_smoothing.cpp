@@ -3,8 +3,6 @@
 // include/voxpress/smooth/mesh_smoothing.h.
 #include "voxpress/smooth/mesh_smoothing.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -14,6 +12,7 @@
 #include "core/timing.h"
 #include "smooth/surface_graph.h"
 #include "voxpress/core/error.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -268,7 +267,7 @@ SmoothStats fair(Mesh& mesh, const FairOptions& o) {
   std::vector<double> change(n, 0.0);
   // One simultaneous umbrella step x += f (mean(neighbours) - x).
   auto step = [&](double f) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(n, 4096, [&](detail::IndexRange r) {
       for (size_t v = r.begin(); v != r.end(); ++v) {
         const uint32_t b = off[v], e = off[v + 1];
         if (b == e) {

@@ -19,8 +19,6 @@
 // with the cell's area).
 #include "voxpress/smooth/pressing.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
@@ -34,6 +32,7 @@
 #include "core/timing.h"
 #include "extract/stick_box.h"
 #include "smooth/curve_kernel.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -55,7 +54,7 @@ void detail::make_layout(const StickSurface& s, const SliceCurves& curves, Layou
   const auto lower = [&](size_t i) { return s.lower_index(i); };
   const IndexBox<3> box = stick_box<3>(n, lower);
   std::vector<std::pair<uint64_t, uint32_t>> sorted(n);  // (brick Morton code, canonical id)
-  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+  detail::parallel_for(n, [&](size_t i) {
     const auto l = s.lower_index(i);
     uint64_t m = 0;
     for (int b = 0; b < 16; ++b)
@@ -67,7 +66,7 @@ void detail::make_layout(const StickSurface& s, const SliceCurves& curves, Layou
   auto& new_of = out.new_of;
   old_of.resize(n);
   new_of.resize(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+  detail::parallel_for(n, [&](size_t i) {
     const uint32_t old = sorted[i].second;
     old_of[i] = old;
     new_of[old] = uint32_t(i);
@@ -88,7 +87,7 @@ void detail::make_layout(const StickSurface& s, const SliceCurves& curves, Layou
     f.base.resize(m);
     f.mov.resize(m);
     f.dst.resize(m);
-    tbb::parallel_for(size_t(0), m, [&](size_t k) {
+    detail::parallel_for(m, [&](size_t k) {
       const uint32_t id = curves.ids[a][k];
       const auto l = s.lower_index(id);
       ids[a][k] = new_of[id];
@@ -117,14 +116,14 @@ PressStats detail::press_on(StickSurface& s, const Layout& L, const PressOptions
     if (barrier[i] && (frozen.empty() || !frozen[i])) throw std::invalid_argument("press: a barrier vertex must be frozen");
   std::vector<double> t(n);
   std::vector<uint8_t> fz(frozen.empty() ? 0 : n), br(barrier.empty() ? 0 : n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+  detail::parallel_for(n, [&](size_t i) {
     const uint32_t old = L.old_of[i];
     t[i] = s.t[old];
     if (!fz.empty()) fz[i] = frozen[old];
     if (!br.empty()) br[i] = barrier[old];
   });
   const PressStats st = detail::iterate(t, L.families, 2, fz, br, o, press_levels_for_extent(o.levels, L.extent));
-  tbb::parallel_for(size_t(0), n, [&](size_t i) { s.t[L.old_of[i]] = t[i]; });
+  detail::parallel_for(n, [&](size_t i) { s.t[L.old_of[i]] = t[i]; });
   return st;
 }
 

@@ -1,7 +1,6 @@
 // Beyond the paper: the local quadric fit after pressing. Theory of
 // operation: include/voxpress/smooth/pressing.h (fit_local_quadrics).
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +13,7 @@
 #include "stick_solid.h"
 #include "surface_graph.h"
 #include "voxpress/smooth/pressing.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -152,7 +152,7 @@ std::vector<uint8_t> choose_sites(const StickSurface& s, const std::vector<uint3
   const size_t n = s.stick_count();
   std::vector<uint64_t> prio(n, 0);
   tbb::enumerable_thread_specific<std::vector<uint32_t>> codes;
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     if (ok(v)) prio[v] = site_priority(s, off, adj, uint32_t(v), codes.local());
   });
   enum : uint8_t { kOut, kOpen, kSite, kCovered };
@@ -166,13 +166,13 @@ std::vector<uint8_t> choose_sites(const StickSurface& s, const std::vector<uint3
       break;
     }
     next = state;
-    tbb::parallel_for(size_t(0), open.size(), [&](size_t i) {
+    detail::parallel_for(open.size(), [&](size_t i) {
       const uint32_t v = open[i];
       for (uint32_t k = off[v]; k < off[v + 1]; ++k)
         if (state[adj[k]] == kOpen && prio[adj[k]] > prio[v]) return;
       next[v] = kSite;
     });
-    tbb::parallel_for(size_t(0), open.size(), [&](size_t i) {
+    detail::parallel_for(open.size(), [&](size_t i) {
       const uint32_t v = open[i];
       if (next[v] == kSite) return;
       for (uint32_t k = off[v]; k < off[v + 1]; ++k)
@@ -214,7 +214,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
   // stick's inside and outside samples (lattice points: exact in float).
   std::vector<Vec3> x(n);
   std::vector<std::array<Eigen::Vector3f, 2>> samples(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     x[v] = s.index_position(v);
     samples[v] = {s.inside_sample(v).cast<float>(), s.outside_sample(v).cast<float>()};
   });
@@ -236,7 +236,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
         for (const auto& [w, ring] : rs.out) needed[w] = 1;
       }
   }
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     if (!site[v] || (only && !needed[v])) return;
     FitScratch& f = scratch.local();
     detail::rings_around(uint32_t(v), uint32_t(o.rings), off, adj, [&](uint32_t w) { return fresh(w); }, f.rings);
@@ -269,7 +269,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
     q.q = quad[v].q;
     return q;
   };
-  tbb::parallel_for(size_t(0), n, [&](size_t v) {
+  detail::parallel_for(n, [&](size_t v) {
     if (!fresh(v) || (only && !(*only)[v])) return;
     const bool lower_in = s.lower_inside(v);
     const Vec3 in = inside(v), out = outside(v);

@@ -1,7 +1,6 @@
 // The curves Pressing runs on (Chica et al., Section 4): the lattice-plane
 // cuts of a stick surface, and the 2D contours of an image (marching
 // squares). Theory of operation: include/voxpress/smooth/pressing.h.
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -9,6 +8,7 @@
 #include "core/sentinel.h"
 #include "voxpress/extract/cube_cases.h"
 #include "voxpress/smooth/pressing.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -17,7 +17,7 @@ using detail::kNone;
 SliceCurves build_slice_curves(const StickSurface& s) {
   const size_t n = s.stick_count();
   std::vector<std::array<int64_t, 3>> lo(n);
-  tbb::parallel_for(size_t(0), n, [&](size_t i) { lo[i] = s.lower_index(i); });
+  detail::parallel_for(n, [&](size_t i) { lo[i] = s.lower_index(i); });
   // Two neighbours per stick and plane slot.
   std::vector<uint32_t> nb(4 * n, kNone);
   auto link = [&](uint32_t u, uint32_t v, int slot) {

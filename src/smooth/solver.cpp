@@ -32,7 +32,6 @@
 // apart (about 1 % of the vertices are clamped at the fixed point): a heavier
 // momentum only makes the residual ring (BENCHMARKS.md, The solver).
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -42,6 +41,7 @@
 
 #include "core/timing.h"
 #include "smooth/curve_kernel.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -122,7 +122,7 @@ class Sweeper {
  private:
   // step[i]: vertex i's proposals combined (PressOptions::weighting).
   void combine(size_t n, std::vector<double>& step) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(n, 1 << 14, [&](detail::IndexRange r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         if (!frozen_.empty() && frozen_[i]) {
           step[i] = 0;
@@ -166,7 +166,7 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
   const double d = o_.arc_length * scale * fam.cell;
   const auto& frozen = frozen_;
   const auto& barrier = barrier_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, off.size() - 1, 32), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(off.size() - 1, 32, [&](detail::IndexRange r) {
     detail::Scratch<Vec2> w;
     for (size_t c = r.begin(); c < r.end(); ++c) {
       auto emit = [&](uint32_t k, uint32_t i) {  // k: curve-vertex index, i: its place in the scratch
@@ -247,7 +247,7 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
       any = measured = true;
       if (st.residual <= o.tolerance) break;
     }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    detail::parallel_ranges(n, 1 << 14, [&](detail::IndexRange r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         if (!frozen.empty() && frozen[i]) continue;
         double dt = step[i];

@@ -1,7 +1,6 @@
 // Texture atlas: charts, rasterization, packing, dilation (see atlas.h).
 #include "atlas.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +9,7 @@
 
 #include "voxpress/core/error.h"
 #include "voxpress/core/memory_budget.h"
+#include "core/parallel.h"
 
 namespace voxpress::detail {
 namespace {
@@ -334,7 +334,7 @@ AtlasResult build_atlas(const Mesh& m, const AtlasOptions& options,
   tex.rgba.assign(size_t(4 * tex.width * tex.height), 0);
   // Render each chart (in parallel: charts own disjoint rectangles), then
   // dilate its colours into its padding.
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, charts.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(charts.size(), 16, [&](detail::IndexRange r) {
     for (size_t ci = r.begin(); ci != r.end(); ++ci) {
       const Chart& c = charts[ci];
       std::vector<Rgba> local(size_t(c.w * c.h), Rgba{0, 0, 0, 0});

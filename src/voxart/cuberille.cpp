@@ -1,5 +1,4 @@
 // Solid, cuberille quads and Lanczos fairing (Muniz et al., Sections 4.2-4.3).
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +7,7 @@
 #include "core/sentinel.h"
 #include "voxpress/core/error.h"
 #include "voxpress/voxart/polygonize.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 namespace {
@@ -288,7 +288,7 @@ void fair_lanczos(QuadMesh& mesh, double lambda) {
     const double l = 1 - 3 * std::sin(pu) * std::sin(pu / 3) / (pu * pu);
     return u > 0 ? l : -l;
   };
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& r) {
+  detail::parallel_ranges(nv, 4096, [&](detail::IndexRange r) {
     std::vector<uint32_t> local;
     for (size_t v = r.begin(); v != r.end(); ++v) {
       local.assign(nb.begin() + start[v], nb.begin() + start[v + 1]);

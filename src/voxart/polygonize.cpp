@@ -1,7 +1,6 @@
 // polygonize_voxel_art: the Muniz et al. pipeline over every part (see polygonize.h).
 #include "voxpress/voxart/polygonize.h"
 
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -14,6 +13,7 @@
 #include "voxpress/smooth/mesh_smoothing.h"
 #include "voxpress/simplify/simplify.h"
 #include "voxpress/smooth/pipeline.h"
+#include "core/parallel.h"
 
 namespace voxpress {
 
@@ -222,7 +222,7 @@ void vertex_attributes(Mesh& work, bool texture, const FaceColor& face_color) {
     fn[f] = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero();
     for (uint32_t v : t) ++start[v + 1];
   }
-  tbb::parallel_for(size_t(0), fc.size(), [&](size_t f) {
+  detail::parallel_for(fc.size(), [&](size_t f) {
     const auto& t = work.triangles[f];
     fc[f] = face_color(uint32_t(f), (work.positions[t[0]] + work.positions[t[1]] + work.positions[t[2]]) / 3);
   });
@@ -232,7 +232,7 @@ void vertex_attributes(Mesh& work, bool texture, const FaceColor& face_color) {
     for (uint32_t v : work.triangles[f]) adj[fill[v]++] = f;
   work.normals.assign(nv, Vec3::UnitZ());
   if (!texture) work.colors.assign(nv, Rgba{0, 0, 0, 255});
-  tbb::parallel_for(size_t(0), nv, [&](size_t v) {
+  detail::parallel_for(nv, [&](size_t v) {
     std::vector<Vec3> seen;
     Vec3 sum = Vec3::Zero();
     double rgb[3] = {0, 0, 0};
@@ -266,7 +266,7 @@ struct ColorFidelity {
     std::optional<detail::MeshQuery> q;
     if (!direct) q.emplace(out);
     std::vector<uint8_t> exact(quad_color.size(), 0);
-    tbb::parallel_for(size_t(0), quad_color.size(), [&](size_t i) {
+    detail::parallel_for(quad_color.size(), [&](size_t i) {
       uint32_t f;
       Vec3 p;
       if (direct) {
