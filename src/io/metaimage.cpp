@@ -54,16 +54,23 @@ std::vector<double> numbers(const std::string& path, const std::string& s, const
   return out;
 }
 
-}  // namespace
+// The header's "Key = Value" lines up to ElementDataFile (keys lower-cased),
+// the LIST's file names, and where LOCAL data starts.
+struct MetaHeader {
+  std::map<std::string, std::string> kv;
+  std::vector<std::string> list_files;
+  uint64_t data_offset = 0;
+  const std::string* get(const char* k) const {
+    const auto it = kv.find(k);
+    return it == kv.end() ? nullptr : &it->second;
+  }
+};
 
-ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
+MetaHeader read_header(const std::string& path) {
   const uint64_t fsize = file_size(path);
   const auto head = read_range(path, 0, std::min<uint64_t>(fsize, 1 << 20));
   const std::string text(reinterpret_cast<const char*>(head.data()), head.size());
-  std::map<std::string, std::string> kv;  // keys lower-cased
-  std::vector<std::string> list_files;
-  uint64_t data_offset = 0;
-  bool found_data = false;
+  MetaHeader h;
   size_t pos = 0;
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
@@ -76,33 +83,28 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
     if (eq == std::string::npos) throw InputError(path, "malformed MetaImage header line '" + line + "'");
     const std::string key = lower(trim(line.substr(0, eq)));
     const std::string value = trim(line.substr(eq + 1));
-    kv[key] = value;
-    if (key == "elementdatafile") {
-      found_data = true;
-      data_offset = pos;
-      if (value.rfind("LIST", 0) == 0) {
-        while (pos < text.size()) {
-          size_t e = text.find('\n', pos);
-          if (e == std::string::npos) e = text.size();
-          const std::string f = trim(text.substr(pos, e - pos));
-          pos = std::min(e + 1, text.size());
-          if (!f.empty()) list_files.push_back(f);
-        }
+    h.kv[key] = value;
+    if (key != "elementdatafile") continue;
+    h.data_offset = pos;
+    if (value.rfind("LIST", 0) == 0)
+      while (pos < text.size()) {
+        size_t e = text.find('\n', pos);
+        if (e == std::string::npos) e = text.size();
+        const std::string f = trim(text.substr(pos, e - pos));
+        pos = std::min(e + 1, text.size());
+        if (!f.empty()) h.list_files.push_back(f);
       }
-      break;
-    }
+    return h;
   }
-  if (!found_data) throw InputError(path, "not a MetaImage file (no ElementDataFile line)");
-  auto get = [&](const char* k) -> const std::string* {
-    auto it = kv.find(k);
-    return it == kv.end() ? nullptr : &it->second;
-  };
-  ScalarVolume v;
-  v.source = path;
+  throw InputError(path, "not a MetaImage file (no ElementDataFile line)");
+}
+
+// The lattice and the sample type; returns NDims.
+int64_t read_geometry(const std::string& path, const MetaHeader& h, ScalarVolume& v) {
   v.lattice.space = Space::LPS;
-  const std::string* ndims = get("ndims");
-  const std::string* dimsize = get("dimsize");
-  const std::string* etype = get("elementtype");
+  const std::string* ndims = h.get("ndims");
+  const std::string* dimsize = h.get("dimsize");
+  const std::string* etype = h.get("elementtype");
   if (!ndims || !dimsize || !etype) throw InputError(path, "MetaImage header lacks NDims, DimSize or ElementType");
   const int64_t nd = parse_int(path, *ndims, "NDims");
   if (nd < 2 || nd > 3) throw InputError(path, "MetaImage with NDims = " + std::to_string(nd) + " is not supported");
@@ -114,23 +116,23 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
       throw InputError(path, "DimSize values must be whole numbers from 1 to 2^40");
     v.lattice.dims[size_t(a)] = int64_t(d);
   }
-  if (const auto* ch = get("elementnumberofchannels"); ch && parse_int(path, *ch, "ElementNumberOfChannels") != 1)
+  if (const auto* ch = h.get("elementnumberofchannels"); ch && parse_int(path, *ch, "ElementNumberOfChannels") != 1)
     throw InputError(path, "multi-channel MetaImage is not supported");
   v.type = met_type(path, *etype);
-  const std::string* sp = get("elementspacing");
-  if (!sp) sp = get("elementsize");
+  const std::string* sp = h.get("elementspacing");
+  if (!sp) sp = h.get("elementsize");
   if (sp) {
     const auto s = numbers(path, *sp, "ElementSpacing");
     for (int a = 0; a < std::min<int>(int(nd), int(s.size())); ++a) v.lattice.spacing[a] = s[size_t(a)];
   }
   for (const char* k : {"offset", "origin", "position"})
-    if (const auto* o = get(k)) {
+    if (const auto* o = h.get(k)) {
       const auto s = numbers(path, *o, "Offset");
       for (int a = 0; a < std::min<int>(int(nd), int(s.size())); ++a) v.lattice.origin[a] = s[size_t(a)];
       break;
     }
   for (const char* k : {"transformmatrix", "rotation", "orientation"})
-    if (const auto* t = get(k)) {
+    if (const auto* t = h.get(k)) {
       const auto s = numbers(path, *t, "TransformMatrix");
       if (int64_t(s.size()) != nd * nd) throw InputError(path, "TransformMatrix must have NDims^2 values");
       for (int a = 0; a < nd; ++a)
@@ -143,28 +145,19 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   } catch (const UsageError& e) {
     throw InputError(path, e.what());
   }
-  const size_t vs = scalar_size(v.type);
-  const uint64_t count = checked_count(path, v.lattice.dims, 1, vs);
-  const uint64_t bytes = count * vs;
-  check_limit(path, bytes, max_bytes, "the volume");
-  bool big = false;
-  for (const char* k : {"binarydatabyteordermsb", "elementbyteordermsb"})
-    if (const auto* b = get(k)) big = truthy(*b);
-  const bool compressed = get("compresseddata") && truthy(*get("compresseddata"));
-  // ASCII data (BinaryData = False) was refused as "data size does not match" (issue 73).
-  if (const auto* bd = get("binarydata"); bd && !truthy(*bd))
-    throw InputError(path, "BinaryData = " + *bd + ": text (ASCII) MetaImage data is not supported");
-  int64_t header_size = 0;
-  if (const auto* hs = get("headersize")) header_size = parse_int(path, *hs, "HeaderSize");
-  if (header_size < -1) throw InputError(path, "HeaderSize is " + std::to_string(header_size) + " (must be -1 or more)");
+  return nd;
+}
 
-  const std::string& df = *get("elementdatafile");
+// The files the data is in, each with the offset where its part starts
+// (before HeaderSize), every one present.
+std::vector<std::pair<std::string, uint64_t>> data_sources(const std::string& path, const MetaHeader& h) {
+  const std::string& df = *h.get("elementdatafile");
   const std::filesystem::path base = std::filesystem::path(path).parent_path();
   std::vector<std::pair<std::string, uint64_t>> sources;  // file, offset
   if (df == "LOCAL") {
-    sources.push_back({path, data_offset});
+    sources.push_back({path, h.data_offset});
   } else if (df.rfind("LIST", 0) == 0) {
-    for (const auto& f : list_files) sources.push_back({(base / f).string(), 0});
+    for (const auto& f : h.list_files) sources.push_back({(base / f).string(), 0});
     if (sources.empty()) throw InputError(path, "ElementDataFile = LIST names no file");
   } else if (split_ws(df).size() > 1) {
     throw InputError(path, "MetaImage ElementDataFile patterns are not supported");
@@ -176,42 +169,81 @@ ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
   for (const auto& src : sources)
     if (std::error_code ec; !std::filesystem::exists(src.first, ec))
       throw InputError(path, "its data file " + src.first + " does not exist");
-  if (compressed) {
-    std::vector<std::byte> z;
-    for (const auto& [file, off] : sources) {
-      const uint64_t fs = file_size(file);
-      if (off >= fs) throw InputError(file, "truncated: no compressed data");
-      check_limit(file, fs - off, max_bytes, "the compressed payload");
-      auto part = read_range(file, off, fs - off);
-      z.insert(z.end(), part.begin(), part.end());
-    }
-    if (const auto* cs = get("compresseddatasize")) {
-      const int64_t n = parse_int(path, *cs, "CompressedDataSize");
-      if (n > 0 && uint64_t(n) < z.size()) z.resize(size_t(n));
-    }
-    v.bytes = inflate_grown(path, z.data(), z.size(), bytes);
-  } else {
-    v.bytes.resize(bytes);
-    if (sources.size() > 1 && bytes % sources.size()) throw InputError(path, "LIST files cannot split the data evenly");
-    const uint64_t per = bytes / sources.size();
-    for (size_t i = 0; i < sources.size(); ++i) {
-      const auto& [file, off0] = sources[i];
-      const uint64_t fs = file_size(file);
-      uint64_t off = off0;
-      if (header_size == -1)
-        off = fs >= per ? fs - per : 0;
-      else
-        off += uint64_t(std::max<int64_t>(header_size, 0));
-      const uint64_t avail = fs > off ? fs - off : 0;
-      if (avail < per)
-        throw InputError(file, "truncated: the header declares " + std::to_string(per) + " bytes of data but " +
-                                   std::to_string(avail) + " are present");
-      if (avail > per && header_size != -1)
-        throw InputError(file, "the data size does not match the header: " + std::to_string(avail) +
-                                   " bytes present, " + std::to_string(per) + " declared");
-      read_range_into(file, off, v.bytes.data() + i * per, per);
-    }
+  return sources;
+}
+
+// `bytes` of raw data from the sources: each holds an equal part, after
+// HeaderSize bytes (-1: the part ends the file), and exactly that much.
+void read_raw(const std::string& path, const std::vector<std::pair<std::string, uint64_t>>& sources,
+              int64_t header_size, uint64_t bytes, std::vector<std::byte>& out) {
+  out.resize(bytes);
+  if (sources.size() > 1 && bytes % sources.size()) throw InputError(path, "LIST files cannot split the data evenly");
+  const uint64_t per = bytes / sources.size();
+  for (size_t i = 0; i < sources.size(); ++i) {
+    const auto& [file, off0] = sources[i];
+    const uint64_t fs = file_size(file);
+    uint64_t off = off0;
+    if (header_size == -1)
+      off = fs >= per ? fs - per : 0;
+    else
+      off += uint64_t(std::max<int64_t>(header_size, 0));
+    const uint64_t avail = fs > off ? fs - off : 0;
+    if (avail < per)
+      throw InputError(file, "truncated: the header declares " + std::to_string(per) + " bytes of data but " +
+                                 std::to_string(avail) + " are present");
+    if (avail > per && header_size != -1)
+      throw InputError(file, "the data size does not match the header: " + std::to_string(avail) +
+                                 " bytes present, " + std::to_string(per) + " declared");
+    read_range_into(file, off, out.data() + i * per, per);
   }
+}
+
+// The zlib stream the sources hold one after the other (CompressedDataSize
+// may cut it), inflated to exactly `bytes`.
+void read_compressed(const std::string& path, const MetaHeader& h,
+                     const std::vector<std::pair<std::string, uint64_t>>& sources, uint64_t bytes, uint64_t max_bytes,
+                     std::vector<std::byte>& out) {
+  std::vector<std::byte> z;
+  for (const auto& [file, off] : sources) {
+    const uint64_t fs = file_size(file);
+    if (off >= fs) throw InputError(file, "truncated: no compressed data");
+    check_limit(file, fs - off, max_bytes, "the compressed payload");
+    auto part = read_range(file, off, fs - off);
+    z.insert(z.end(), part.begin(), part.end());
+  }
+  if (const auto* cs = h.get("compresseddatasize")) {
+    const int64_t n = parse_int(path, *cs, "CompressedDataSize");
+    if (n > 0 && uint64_t(n) < z.size()) z.resize(size_t(n));
+  }
+  out = inflate_grown(path, z.data(), z.size(), bytes);
+}
+
+}  // namespace
+
+ScalarVolume read_metaimage(const std::string& path, uint64_t max_bytes) {
+  const MetaHeader h = read_header(path);
+  ScalarVolume v;
+  v.source = path;
+  read_geometry(path, h, v);
+  const size_t vs = scalar_size(v.type);
+  const uint64_t count = checked_count(path, v.lattice.dims, 1, vs);
+  const uint64_t bytes = count * vs;
+  check_limit(path, bytes, max_bytes, "the volume");
+  bool big = false;
+  for (const char* k : {"binarydatabyteordermsb", "elementbyteordermsb"})
+    if (const auto* b = h.get(k)) big = truthy(*b);
+  const bool compressed = h.get("compresseddata") && truthy(*h.get("compresseddata"));
+  // ASCII data (BinaryData = False) was refused as "data size does not match" (issue 73).
+  if (const auto* bd = h.get("binarydata"); bd && !truthy(*bd))
+    throw InputError(path, "BinaryData = " + *bd + ": text (ASCII) MetaImage data is not supported");
+  int64_t header_size = 0;
+  if (const auto* hs = h.get("headersize")) header_size = parse_int(path, *hs, "HeaderSize");
+  if (header_size < -1) throw InputError(path, "HeaderSize is " + std::to_string(header_size) + " (must be -1 or more)");
+  const auto sources = data_sources(path, h);
+  if (compressed)
+    read_compressed(path, h, sources, bytes, max_bytes, v.bytes);
+  else
+    read_raw(path, sources, header_size, bytes, v.bytes);
   if (big && vs > 1) swap_bytes(v.bytes.data(), count, vs);
   return v;
 }
