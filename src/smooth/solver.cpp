@@ -17,20 +17,16 @@
 // momentum on each change of t; the last stage is the map at d, and the
 // solve stops there as soon as the residual is met, or at the sweep cap.
 // The residual is always measured on the map at d at the returned t.
-// Tried and measured (docs/BENCHMARKS.md, Pressing: the solver): Anderson
-// acceleration of the fine map reaches the fixed point, 2.4 times closer to
-// the truth on a sphere, but only in 300-1,500 steps; a multigrid over the
-// same vertices with the map at 2d as the coarse level diverged; Newton on
-// the map linearized with its virtual neighbours frozen, and a two-grid
-// cycle over the volume subsampled by 2, did not lower the residual; an
-// energy with frozen resampling weights minimized by projected Newton
-// converged 10 % per outer step at 10-250 times the cost. The CAD part's
-// residual was a loop around one sample in a 2-cycle (curve_kernel.h: tiny
-// loops now shrink d continuously); what is left there is a few soft
-// sliding vertices (a stick nearly along its curve) drifting slowly, and on
-// a sphere the bilaplacian's mid-length waves between contacts ~10 cells
-// apart (about 1 % of the vertices are clamped at the fixed point): a heavier
-// momentum only makes the residual ring (BENCHMARKS.md, The solver).
+// Why it is slow (docs/BENCHMARKS.md, Pressing: the solver): the fixed
+// point is nearly singular. The bilaplacian's null space (curves locally
+// cubic) is pinned only by the few vertices at their clamps (under 1 %), so
+// the map's exact Jacobian has a global smooth direction of eigenvalue
+// ~1e-4 along which its quadratic term dominates: Newton on it, Anderson
+// acceleration, multigrids over the map at 2d or over a subsampled volume,
+// and frozen-weight energies were measured and dropped, and a pull towards
+// the midpoint surface that makes it well posed costs fidelity (the
+// midpoint's long waves follow the lattice's terraces). A heavier momentum
+// only makes the residual ring.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
