@@ -104,12 +104,20 @@ void Sharpener::snap_to_flats() {
   const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, 2, adj_off, adj);
   std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
   std::vector<double> t(n, 0);
+  // Rings to the nearest flat member, up to twice kSnapRings: farther than
+  // its reach, solid_crossing finds no flat (its ring holds no member), so
+  // the vertex is not searched (on a CAD part most of a curved face).
+  std::vector<uint32_t> to_flat(n, detail::kUnreached), members;
+  for (uint32_t v = 0; v < n; ++v)
+    if (seg.region[v] >= 0) to_flat[v] = 0, members.push_back(v);
+  detail::spread_rings(std::move(members), 0, 2 * uint32_t(detail::kSnapRings), adj_off, adj, to_flat,
+                       [](uint32_t, uint32_t) { return true; });
   tbb::enumerable_thread_specific<SnapScratch> scratch;
   detail::parallel_ranges(uint32_t(n), 256, [&](detail::IndexRange r) {
     SnapScratch& sc = scratch.local();
     for (uint32_t v = r.begin(); v < r.end(); ++v) {
       const bool member = seg.region[v] >= 0;
-      if (member && depth[v] > 2) continue;
+      if ((member && depth[v] > 2) || to_flat[v] > uint32_t(detail::kSnapRings)) continue;
       if (!solid_crossing(v, member, uint32_t(detail::kSnapRings), sc, flat[v], t[v]) || flat[v] == seg.region[v])
         flat[v] = -1;
     }
@@ -125,7 +133,8 @@ void Sharpener::snap_to_flats() {
     if (explained >= patch.size() / 2 && double(explained) < detail::kSnapShare * double(patch.size()))
       for (uint32_t v : patch)
         if (flat[v] < 0) {
-          if (solid_crossing(v, false, 2 * uint32_t(detail::kSnapRings), wide, flat[v], t[v])) {
+          if (to_flat[v] <= 2 * uint32_t(detail::kSnapRings) &&
+              solid_crossing(v, false, 2 * uint32_t(detail::kSnapRings), wide, flat[v], t[v])) {
             ++explained;
           } else {
             flat[v] = -1;
