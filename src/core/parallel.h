@@ -36,8 +36,10 @@ class RangeBody {
   void (*call_)(void*, IndexRange);
 };
 
-// Runs body over chunks of [0, n) of at least `grain` indices, in parallel
-// (TBB's auto partitioner, in the current arena).
+// Runs body over chunks of [0, n), in parallel (TBB's blocked_range and
+// auto partitioner, in the current arena: a chunk is split in halves only
+// while longer than `grain`, so every chunk holds at least grain / 2
+// indices, or all n when n <= grain).
 void parallel_ranges(size_t n, size_t grain, RangeBody body);
 
 // body(i) for every i in [0, n), in parallel.
