@@ -226,6 +226,18 @@ void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const st
                                " (raise it with --max-memory)");
 }
 
+uint64_t data_part(const std::string& file, uint64_t fsize, uint64_t start, int64_t skip, uint64_t per) {
+  const uint64_t off = skip == -1 ? (fsize >= per ? fsize - per : 0) : start + uint64_t(std::max<int64_t>(skip, 0));
+  const uint64_t avail = fsize > off ? fsize - off : 0;
+  if (avail < per)
+    throw InputError(file, "truncated: the header declares " + std::to_string(per) + " bytes of data but " +
+                               std::to_string(avail) + " are present");
+  if (avail > per && skip != -1)
+    throw InputError(file, "the data size does not match the header: " + std::to_string(avail) + " bytes present, " +
+                               std::to_string(per) + " declared");
+  return off;
+}
+
 uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
                        size_t value_size) {
   uint64_t n = 1;

@@ -75,6 +75,11 @@ inline bool whole_in(double x, double lo, double hi) { return x >= lo && x <= hi
 std::string format_bytes(uint64_t bytes);
 /// Throws LimitError(path, ...) if `bytes` exceeds the cap (0 = no cap).
 void check_limit(const std::string& path, uint64_t bytes, uint64_t cap, const std::string& what);
+/// Where a part of `per` bytes of raw data starts in `file` (fsize bytes):
+/// `skip` bytes past `start`, or with skip -1 the file's last `per` bytes
+/// (NRRD's byte skip, MetaImage's HeaderSize). Throws InputError naming the
+/// file unless the part is all there and, with skip >= 0, all that follows.
+uint64_t data_part(const std::string& file, uint64_t fsize, uint64_t start, int64_t skip, uint64_t per);
 /// dims product with overflow check; throws InputError on absurd dimensions.
 uint64_t checked_count(const std::string& path, const std::array<int64_t, 3>& dims, int64_t components,
                        size_t value_size);

@@ -181,19 +181,7 @@ void read_raw(const std::string& path, const std::vector<std::pair<std::string, 
   const uint64_t per = bytes / sources.size();
   for (size_t i = 0; i < sources.size(); ++i) {
     const auto& [file, off0] = sources[i];
-    const uint64_t fs = file_size(file);
-    uint64_t off = off0;
-    if (header_size == -1)
-      off = fs >= per ? fs - per : 0;
-    else
-      off += uint64_t(std::max<int64_t>(header_size, 0));
-    const uint64_t avail = fs > off ? fs - off : 0;
-    if (avail < per)
-      throw InputError(file, "truncated: the header declares " + std::to_string(per) + " bytes of data but " +
-                                 std::to_string(avail) + " are present");
-    if (avail > per && header_size != -1)
-      throw InputError(file, "the data size does not match the header: " + std::to_string(avail) +
-                                 " bytes present, " + std::to_string(per) + " declared");
+    const uint64_t off = data_part(file, file_size(file), off0, header_size, per);
     read_range_into(file, off, out.data() + i * per, per);
   }
 }

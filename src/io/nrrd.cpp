@@ -373,20 +373,7 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     for (size_t f = 0; f < sources.size(); ++f) {
       const std::string& file = sources[f];
       const uint64_t fsize = file_size(file);
-      uint64_t off = data_start(file);
-      if (byte_skip == -1) {
-        if (fsize < per_file) throw InputError(file, "truncated: the file is smaller than the data the header declares");
-        off = fsize - per_file;
-      } else {
-        off += uint64_t(std::max<int64_t>(byte_skip, 0));
-      }
-      const uint64_t avail = fsize > off ? fsize - off : 0;
-      if (avail < per_file)
-        throw InputError(file, "truncated: the header declares " + std::to_string(per_file) + " bytes of data but " +
-                                   std::to_string(avail) + " are present");
-      if (avail > per_file && byte_skip != -1)
-        throw InputError(file, "the data size does not match the header: " + std::to_string(avail) +
-                                   " bytes present, " + std::to_string(per_file) + " declared by sizes and type");
+      const uint64_t off = data_part(file, fsize, data_start(file), byte_skip, per_file);
       parts.push_back({file, off, per_file});
     }
     if (raw) {
