@@ -1,16 +1,13 @@
 // Private: the library's parallel loops. Every loop goes through one
 // non-template entry point (parallel.cpp), so TBB's scheduler templates are
-// compiled once, not once per lambda (each tbb::parallel_for instantiation
-// is ~11 KB of code; the sanitized library spent ~40 s of CPU on them). A
-// call site compiles only its own loop body. Chunks are disjoint and each
-// index is visited once, so results that are written per index do not
-// depend on the thread count.
+// compiled once, not once per lambda; a call site compiles only its own
+// loop body. Chunks are disjoint and each index is visited once, so results
+// written per index do not depend on the thread count.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
-#include <utility>
 
 namespace voxpress::detail {
 

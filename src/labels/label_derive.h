@@ -9,7 +9,8 @@
 
 namespace voxpress::detail {
 
-/// The case of a pattern of ranks 0..m-1 (m >= 2: the binary case for two).
+/// The case of a pattern of ranks 0..m-1 (no triangles below two labels; the
+/// binary case, the larger label inside, for two).
 LabelCase derive_label_case(const LabelPattern& ranks);
 /// How many distinct ranks r[0..n) holds (each below 8).
 int distinct_count(const uint8_t* r, int n);
