@@ -55,11 +55,13 @@ PressOptions estimate_options(const PressOptions& po, int levels) {
 // press a copy, detect, and (beyond the paper) press again with the first
 // flats frozen and detect from scratch. `est` ends as the last estimate;
 // `plain` tells whether it is still the plain press of the surface (no
-// flats were frozen in it), with `first` its stats.
+// flats were frozen in it), with `first` its stats and `options` the first
+// estimate's press.
 struct Segmented {
   FlatSegmentation seg;
   StickSurface est;
   PressStats first;
+  PressOptions options;
   bool plain = true;
 };
 
@@ -68,7 +70,8 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
-  const PressOptions eo = estimate_options(po, press_levels(s, po.levels));
+  g.options = estimate_options(po, press_levels(s, po.levels));
+  const PressOptions& eo = g.options;
   g.first = detail::press_on(g.est, layout, eo);
   double t_est = seconds_since(t0);
   // The crease refit serves the final planes only: refitting a first pass's
@@ -131,7 +134,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   const PressStats& first_estimate = g.first;
   const StickSurface& est = g.est;
   const bool est_is_plain = g.plain;
-  const PressOptions eo = estimate_options(po, press_levels(s, po.levels));
+  const PressOptions& eo = g.options;
   apply_flats(s, seg);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
   // by the curved side's fit (fit_creases), and those of creases between

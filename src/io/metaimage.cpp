@@ -99,8 +99,8 @@ MetaHeader read_header(const std::string& path) {
   throw InputError(path, "not a MetaImage file (no ElementDataFile line)");
 }
 
-// The lattice and the sample type; returns NDims.
-int64_t read_geometry(const std::string& path, const MetaHeader& h, ScalarVolume& v) {
+// The lattice and the sample type.
+void read_geometry(const std::string& path, const MetaHeader& h, ScalarVolume& v) {
   v.lattice.space = Space::LPS;
   const std::string* ndims = h.get("ndims");
   const std::string* dimsize = h.get("dimsize");
@@ -145,7 +145,6 @@ int64_t read_geometry(const std::string& path, const MetaHeader& h, ScalarVolume
   } catch (const UsageError& e) {
     throw InputError(path, e.what());
   }
-  return nd;
 }
 
 // The files the data is in, each with the offset where its part starts

@@ -372,8 +372,7 @@ ScalarVolume read_nrrd(const std::string& path, uint64_t max_bytes, RawPayload* 
     std::vector<RawPayload::Part> parts;
     for (size_t f = 0; f < sources.size(); ++f) {
       const std::string& file = sources[f];
-      const uint64_t fsize = file_size(file);
-      const uint64_t off = data_part(file, fsize, data_start(file), byte_skip, per_file);
+      const uint64_t off = data_part(file, file_size(file), data_start(file), byte_skip, per_file);
       parts.push_back({file, off, per_file});
     }
     if (raw) {
