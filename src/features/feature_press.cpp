@@ -2,6 +2,7 @@
 // detect, freeze, press, crease rounds; and the region outputs. Theory of
 // operation: include/voxpress/features/flats.h.
 #include "core/timing.h"
+#include "feature_context.h"
 #include "feature_tuning.h"
 #include "smooth/curve_kernel.h"
 #include "voxpress/features/flats.h"
@@ -101,7 +102,10 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
     seg = find_flats(s, curves, g.est.t, pass + 1 < detail::kDetectionPasses ? early : fo);
     seg.stats.seconds_detect += before.seconds_detect;
     seg.stats.seconds_junctions += before.seconds_junctions;
-    for (size_t p = 0; p < size_t(Pass::count); ++p) seg.stats.passes.seconds[p] += before.passes.seconds[p];
+    // The seconds and trace of both detections, the last one's counts.
+    PassTimes& times = seg.stats.passes;
+    for (size_t p = 0; p < size_t(Pass::count); ++p) times.seconds[p] += before.passes.seconds[p];
+    times.trace.insert(times.trace.begin(), before.passes.trace.begin(), before.passes.trace.end());
   }
   seg.stats.seconds_estimate = t_est;
   return g;
@@ -158,39 +162,62 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
     st.press = detail::press_on(s, layout, first, frozen_of(seg), seg.barrier);
   }
   for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
-    std::vector<uint8_t> fixed;
     const auto t2 = std::chrono::steady_clock::now();
-    seg.stats.crease_vertices = fit_creases(s, seg, *fo, &fixed);
-    st.passes.add(Pass::crease_fit, seconds_since(t2), round + 1 == detail::kCreaseRounds ? seg.stats.crease_vertices : 0);
-    const auto t3 = std::chrono::steady_clock::now();
-    // The curved crease vertices cut the slice curves too (barriers), so
-    // neither side's bilaplacian reaches across them.
-    std::vector<uint8_t> barrier = seg.barrier;
-    barrier.resize(s.stick_count(), 0);
-    seg.stats.curved_crease_vertices = fit_curved_creases(s, seg, *fo, fixed, &barrier);
-    st.passes.add(Pass::curved_creases, seconds_since(t3),
-                  round + 1 == detail::kCreaseRounds ? seg.stats.curved_crease_vertices : 0);
+    detail::CreaseRound cr{s, seg, *fo, {}, seg.barrier, round + 1 == detail::kCreaseRounds};
+    cr.barrier.resize(s.stick_count(), 0);
+    detail::FeatureContext fc{fo->passes, st.passes};
+    fc.crease = &cr;
+    detail::run_stage(Stage::crease_round, fc);
     seg.stats.seconds_creases += seconds_since(t2);
-    for (size_t v = 0; v < fixed.size(); ++v) fixed[v] |= seg.region[v] >= 0;
+    cr.fixed.resize(s.stick_count(), 0);
+    for (size_t v = 0; v < cr.fixed.size(); ++v) cr.fixed[v] |= seg.region[v] >= 0;
     PressOptions again = po;
     again.iterations = rest;
     again.levels = 1;  // the fine stage goes on
-    const PressStats ps = detail::press_on(s, layout, again, fixed, barrier);
+    const PressStats ps = detail::press_on(s, layout, again, cr.fixed, cr.barrier);
     st.press.iterations += ps.iterations;
     st.press.seconds += ps.seconds;
     st.press.residual = ps.residual;
   }
   st.flats = seg.stats;
-  // The detection's own passes are timed apart: `flats` is the rest.
+  // The detection's steps were timed by its driver; `flats` also takes the
+  // estimates and the detection's output (sizes, barriers), and counts the
+  // final flats. The crease rounds come after the detection in the trace.
   double sub = 0;
   for (size_t p = 0; p < size_t(Pass::count); ++p) sub += seg.stats.passes.seconds[p];
-  st.passes.add(seg.stats.passes);
+  PassTimes all = seg.stats.passes;
+  all.add(st.passes);
+  st.passes = std::move(all);
   if (po.free_ends) st.passes.count[size_t(Pass::free_ends)] = seg.stats.barriers;  // the curves' cut points
   st.passes.add(Pass::flats, seg.stats.seconds_estimate + seg.stats.seconds_detect + seg.stats.seconds_junctions - sub,
                 seg.flats.size());
   if (out) *out = std::move(seg);
   return st;
 }
+
+namespace detail {
+
+size_t crease_fit_step(FeatureContext& c) {
+  CreaseRound& r = *c.crease;
+  r.seg.stats.crease_vertices = fit_creases(r.s, r.seg, r.o, &r.fixed);
+  return r.last ? r.seg.stats.crease_vertices : 0;
+}
+
+size_t curved_creases_step(FeatureContext& c) {
+  // The curved crease vertices cut the slice curves too (barriers), so
+  // neither side's bilaplacian reaches across them.
+  CreaseRound& r = *c.crease;
+  r.seg.stats.curved_crease_vertices = fit_curved_creases(r.s, r.seg, r.o, r.fixed, &r.barrier);
+  return r.last ? r.seg.stats.curved_crease_vertices : 0;
+}
+
+size_t quadric_fit_step(FeatureContext& c) {
+  FitStage& f = *c.fit;
+  f.out = fit_local_quadrics(f.s, f.seg.region, f.seg.junction, f.o);
+  return f.out.moved;
+}
+
+}  // namespace detail
 
 void add_region_attributes(Mesh& mesh, const FlatSegmentation& f, bool colors) {
   const size_t n = mesh.vertex_count();

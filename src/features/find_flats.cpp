@@ -2,11 +2,12 @@
 // Theory of operation: include/voxpress/features/flats.h. Everything here
 // works in index space (planes are affine-invariant); normals and angles
 // that are compared with user thresholds are taken in the physical frame.
-// find_flats runs the stages in order: votes, greedy extraction, merge
-// (here), then junctions, extension to the sharp edges, rim release, sizes
-// and barriers (flat_junctions.cpp); they share a FlatsContext
-// (flat_detector.h).
+// find_flats runs Stage::detect's passes (the table in passes.cpp): votes
+// and greedy extraction (flats), merge (here), then the extension to the
+// sharp edges (junctions) and the rim release (flat_junctions.cpp), then
+// the sizes and barriers; they share a FlatsContext (flat_detector.h).
 #include "core/timing.h"
+#include "feature_context.h"
 #include "flat_detector.h"
 #include "flat_geometry.h"
 #include "smooth/quadric.h"
@@ -437,6 +438,29 @@ void merge_flats(FlatsContext& ctx) {
 
 }  // namespace
 
+namespace detail {
+
+size_t flats_step(FeatureContext& c) {
+  FlatsContext& ctx = *c.detect;
+  FlatSegmentation& seg = ctx.seg;
+  Votes V = cast_votes(ctx.S, ctx.cone);
+  seg.stats.votes = V.votes;
+  seg.stats.voters = V.voters;
+  seg.stats.cells = V.cell_key.size();
+  ProgressCounter progress(ctx.o.progress, "flats", 0);
+  extract_flats(ctx, V, progress);
+  c.times.count[size_t(Pass::stab_refit)] = ctx.det.restabbed;
+  c.times.count[size_t(Pass::curved_test)] = ctx.det.refused_curved;
+  return 0;  // press_with_flats counts the final flats
+}
+
+size_t merge_step(FeatureContext& c) {
+  if (c.detect->seg.flats.size() > 1) merge_flats(*c.detect);
+  return 0;  // merge_flats counts the merges
+}
+
+}  // namespace detail
+
 FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, const std::vector<double>& estimate,
                             const FlatOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -449,33 +473,17 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   seg.barrier.assign(n, 0);
   if (n == 0) return seg;
   FlatsContext ctx(s, estimate, o, seg);
-
-  // ---- Votes (Section 3).
-  Votes V = cast_votes(ctx.S, ctx.cone);
-  seg.stats.votes = V.votes;
-  seg.stats.voters = V.voters;
-  seg.stats.cells = V.cell_key.size();
-  ProgressCounter progress(o.progress, "flats", 0);
-  extract_flats(ctx, V, progress);
-  const auto t_merge = std::chrono::steady_clock::now();
-  if (o.passes.on(Pass::merge) && seg.flats.size() > 1) merge_flats(ctx);
-  seg.stats.passes.seconds[size_t(Pass::merge)] = seconds_since(t_merge);
-  seg.stats.passes.count[size_t(Pass::stab_refit)] = ctx.det.restabbed;
-  seg.stats.passes.count[size_t(Pass::curved_test)] = ctx.det.refused_curved;
-  seg.stats.seconds_detect = seconds_since(t0);
-
-  // ---- Junctions, the extension to the sharp edges and the rim's release
-  // (flat_junctions.cpp).
-  const auto t1 = std::chrono::steady_clock::now();
-  extend_to_edges(ctx);
-  const auto t_rim = std::chrono::steady_clock::now();
-  if (o.passes.on(Pass::rim_tangent) && !seg.flats.empty()) release_rim(ctx);
-  seg.stats.passes.seconds[size_t(Pass::rim_tangent)] = seconds_since(t_rim);
+  detail::FeatureContext fc{o.passes, seg.stats.passes};
+  fc.detect = &ctx;
+  detail::run_stage(Stage::detect, fc);
+  // The detection's output: the flats' sizes and the slice curves' barriers.
   measure_flats(ctx);
   mark_barriers(ctx, curves);
   seg.stats.passes.count[size_t(Pass::tangent_borders)] = ctx.smooth_borders;
   seg.stats.passes.count[size_t(Pass::ring_off_plane)] = ctx.off_plane_junctions;
-  seg.stats.seconds_junctions = seconds_since(t1);
+  const PassTimes& p = seg.stats.passes;
+  seg.stats.seconds_detect = p.seconds[size_t(Pass::flats)] + p.seconds[size_t(Pass::merge)];
+  seg.stats.seconds_junctions = seconds_since(t0) - seg.stats.seconds_detect;
   return seg;
 }
 

@@ -392,9 +392,9 @@ struct FlatsContext {
   double frozen_t(uint32_t v, const Plane& P) const;
 };
 
-// The stages after detection (flat_junctions.cpp), in find_flats' order.
+// The detection's steps after the growth (flat_junctions.cpp), in find_flats' order.
 void extend_to_edges(FlatsContext& ctx);
-void release_rim(FlatsContext& ctx);
+size_t release_rim(FlatsContext& ctx);  // the members released
 void measure_flats(FlatsContext& ctx);
 void mark_barriers(FlatsContext& ctx, const SliceCurves& curves);
 

@@ -1,9 +1,11 @@
 // Flats' junctions and borders (Chica et al., Section 3, and beyond the
-// paper): the stages of find_flats after detection (find_flats.cpp). The
-// junction test, the extension of the flats to their sharp edges, the rim's
-// release from tangent fillets, the flats' sizes and the barriers. Theory of
+// paper): Stage::detect's passes after the growth (find_flats.cpp). The
+// junction test, the extension of the flats to their sharp edges
+// (junctions), the rim's release from tangent fillets (rim-tangent), the
+// flats' sizes and the barriers. Theory of
 // operation: include/voxpress/features/flats.h.
 #include "core/timing.h"
+#include "feature_context.h"
 #include "flat_detector.h"
 #include "flat_geometry.h"
 #include "smooth/quadric.h"
@@ -254,7 +256,7 @@ void extend_to_edges(FlatsContext& ctx) {
 // members next to the border (one ring) go back to the curved side, unless
 // a junction is within two rings (the rim is the flat's reach to that
 // crease).
-void release_rim(FlatsContext& ctx) {
+size_t release_rim(FlatsContext& ctx) {
   const Surface& S = ctx.S;
   FlatSegmentation& seg = ctx.seg;
   const size_t n = ctx.n;
@@ -297,8 +299,8 @@ void release_rim(FlatsContext& ctx) {
       ++released;
     }
   seg.stats.rim_released = released;
-  seg.stats.passes.count[size_t(Pass::rim_tangent)] = released;
   if (released > 0) detect_junctions(ctx);
+  return released;
 }
 
 // Sizes, once the extension has settled the members. Index-space area ->
@@ -339,3 +341,16 @@ void mark_barriers(FlatsContext& ctx, const SliceCurves& curves) {
 }
 
 }  // namespace voxpress::flats_impl
+
+namespace voxpress::detail {
+
+size_t junctions_step(FeatureContext& c) {
+  flats_impl::extend_to_edges(*c.detect);
+  return 0;  // mark_barriers counts the junctions
+}
+
+size_t rim_tangent_step(FeatureContext& c) {
+  return c.detect->seg.flats.empty() ? 0 : flats_impl::release_rim(*c.detect);
+}
+
+}  // namespace voxpress::detail

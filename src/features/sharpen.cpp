@@ -1,6 +1,9 @@
-// Sharp edge recovery (Chica et al., Section 5): the run and its output.
+// Sharp edge recovery (Chica et al., Section 5): the run (Stage::sharpen's
+// passes, from the table in passes.cpp), the moves and the output.
 // Theory of operation: sharpener.h and include/voxpress/features/sharpen.h.
 #include "sharpener.h"
+
+#include "feature_context.h"
 
 namespace voxpress::sharpen_impl {
 
@@ -11,96 +14,78 @@ SharpenResult Sharpener::run() {
   for (size_t v = 0; v < n; ++v) x[v] = s.index_position(v);
   plane_state.assign(n, 0);
   on_wall.assign(n, 0);
+  crease_side.assign(n, 0);
   plane.resize(n);
   label = seg.region;
   junction = seg.junction;
   junction.resize(n, 0);
-  // Each step timed as its pass (the base steps as `sharpen`).
-  auto timed = [&](Pass p, auto&& step) {
-    const auto t = std::chrono::steady_clock::now();
-    step();
-    st.passes.add(p, std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
-  };
   if (!seg.flats.empty()) {
-    timed(Pass::snap, [&] { snap_to_flats(); });
-    timed(Pass::strips, [&] { join_leftovers(); });
-    timed(Pass::inherit_junctions, [&] { inherit_junctions(); });
-    timed(Pass::walls, [&] { fit_walls(); });
-    timed(Pass::final_crease, [&] { final_crease_fit(); });
-    timed(Pass::past_crease, [&] { past_creases(); });
-    timed(Pass::curved_creases, [&] { curved_creases(); });
-    timed(Pass::sharpen, [&] { subdivide(); });
-  } else {
+    detail::FeatureContext ctx{o.passes, st.passes};
+    ctx.sharpen = this;
+    detail::run_stage(Stage::sharpen, ctx);
+  }
+  if (tris.empty()) {  // no flats (or no chamfer): the surface's own triangles
     tris = s.triangles;
     parent.resize(tris.size());
     std::iota(parent.begin(), parent.end(), 0u);
   }
-  if (!nv.empty()) {
-    build_chains();
-    const auto t = std::chrono::steady_clock::now();
-    judge_chains();  // before index(): it may slide rim pockets
-    st.passes.add(Pass::round_chains, std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count());
-    index();
-    spread_targets();
-    // The moves, in order: leftovers onto their flat, edge vertices onto
-    // their crease, then corners (Section 5). A move blocked by a
-    // neighbour that has not moved yet is retried in the next round; from
-    // round kRounds on, the remaining moves are cut back to what is
-    // allowed; those whose target lies on flats' planes only are retried
-    // (neighbours' cut-back moves may unblock them) while any vertex still
-    // advances, for up to kRounds more rounds. Targets from a curved
-    // side's fit are not pushed further (a leaning curved side's plane
-    // would carry the vertex past the truth).
-    std::vector<std::pair<uint32_t, Vec3>> jobs;
-    std::vector<uint8_t> retry;
-    for (uint32_t v : leftovers) {
-      jobs.push_back({v, x[v] - height(label[v], x[v]) * seg.flats[size_t(label[v])].index_normal});
-      retry.push_back(1);
-    }
-    for (int corners = 0; corners < 2; ++corners)
-      for (size_t i = 0; i < nv.size(); ++i)
-        if (nv[i].moves && nv[i].corner == bool(corners)) {
-          jobs.push_back({uint32_t(n + i), nv[i].target});
-          retry.push_back(nv[i].on_flats);
-        }
-    std::vector<uint8_t> done(jobs.size(), 0);
-    // Neighbours that block each other (two vertices of one thin triangle)
-    // get there together: a blocked vertex goes half way instead.
-    for (int round = 0; round < 2 * kRounds; ++round) {
-      const bool cut = round + 1 >= kRounds;
-      bool advanced = false;
-      for (size_t j = 0; j < jobs.size(); ++j) {
-        if (done[j] || (round >= kRounds && !retry[j])) continue;
-        const uint32_t v = jobs[j].first;
-        const Vec3 before = x[v];
-        done[j] = move(v, jobs[j].second, cut);
-        if (!done[j] && !cut) move(v, (x[v] + jobs[j].second) / 2, false);
-        advanced |= (x[v] - before).squaredNorm() > kAdvance * kAdvance;
-      }
-      if (cut && !advanced) break;
-    }
-    smooth_chains();
-  }
   SharpenResult r;
   r.mesh = output();
-  st.passes.count[size_t(Pass::snap)] = st.snapped;
-  st.passes.count[size_t(Pass::walls)] = st.wall_vertices;
-  st.passes.count[size_t(Pass::final_crease)] = st.final_crease_vertices;
-  st.passes.count[size_t(Pass::past_crease)] = st.past_crease + st.left_flat;
-  st.passes.count[size_t(Pass::inherit_junctions)] = st.inherited_junctions;
-  st.passes.count[size_t(Pass::curved_creases)] += st.curved_crease_vertices;
   st.passes.count[size_t(Pass::tangent_planes)] = st.tangent_planes;
   st.passes.count[size_t(Pass::sample_wedges)] = st.wedge_shifts;
-  st.passes.count[size_t(Pass::round_chains)] = st.round_chains;
-  st.passes.count[size_t(Pass::sharpen)] = st.inserted;
   st.sharp_edges = r.mesh.edges.size();
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  double others = 0;
-  for (size_t p = 0; p < size_t(Pass::count); ++p)
-    if (Pass(p) != Pass::sharpen) others += st.passes.seconds[p];
-  st.passes.seconds[size_t(Pass::sharpen)] = st.seconds - others;
+  // The steps were timed by the driver; `sharpen` also takes the rest
+  // (the setup and the output).
+  double steps = 0;
+  for (size_t p = 0; p < size_t(Pass::count); ++p) steps += st.passes.seconds[p];
+  st.passes.seconds[size_t(Pass::sharpen)] += std::max(0.0, st.seconds - steps);
   r.stats = st;
   return r;
+}
+
+size_t Sharpener::move_all() {
+  index();
+  spread_targets();
+  // The moves, in order: leftovers onto their flat, edge vertices onto
+  // their crease, then corners (Section 5). A move blocked by a
+  // neighbour that has not moved yet is retried in the next round; from
+  // round kRounds on, the remaining moves are cut back to what is
+  // allowed; those whose target lies on flats' planes only are retried
+  // (neighbours' cut-back moves may unblock them) while any vertex still
+  // advances, for up to kRounds more rounds. Targets from a curved
+  // side's fit are not pushed further (a leaning curved side's plane
+  // would carry the vertex past the truth).
+  std::vector<std::pair<uint32_t, Vec3>> jobs;
+  std::vector<uint8_t> retry;
+  for (uint32_t v : leftovers) {
+    jobs.push_back({v, x[v] - height(label[v], x[v]) * seg.flats[size_t(label[v])].index_normal});
+    retry.push_back(1);
+  }
+  for (int corners = 0; corners < 2; ++corners)
+    for (size_t i = 0; i < nv.size(); ++i)
+      if (nv[i].moves && nv[i].corner == bool(corners)) {
+        jobs.push_back({uint32_t(n + i), nv[i].target});
+        retry.push_back(nv[i].on_flats);
+      }
+  std::vector<uint8_t> done(jobs.size(), 0);
+  // Neighbours that block each other (two vertices of one thin triangle)
+  // get there together: a blocked vertex goes half way instead.
+  for (int round = 0; round < 2 * kRounds; ++round) {
+    const bool cut = round + 1 >= kRounds;
+    bool advanced = false;
+    for (size_t j = 0; j < jobs.size(); ++j) {
+      if (done[j] || (round >= kRounds && !retry[j])) continue;
+      const uint32_t v = jobs[j].first;
+      const Vec3 before = x[v];
+      done[j] = move(v, jobs[j].second, cut);
+      if (!done[j] && !cut) move(v, (x[v] + jobs[j].second) / 2, false);
+      advanced |= (x[v] - before).squaredNorm() > kAdvance * kAdvance;
+    }
+    if (cut && !advanced) break;
+  }
+  smooth_chains();
+  return size_t(std::count(done.begin(), done.end(), 1));
 }
 
 Mesh Sharpener::output() const {
@@ -182,3 +167,9 @@ SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats
 }
 
 }  // namespace voxpress
+
+namespace voxpress::detail {
+
+size_t moves_step(FeatureContext& c) { return c.sharpen->nv.empty() ? 0 : c.sharpen->move_all(); }
+
+}  // namespace voxpress::detail

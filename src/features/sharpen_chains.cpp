@@ -29,6 +29,8 @@
 // slide flattens the fillet's start.
 #include "sharpener.h"
 
+#include "feature_context.h"
+
 namespace voxpress::sharpen_impl {
 
 namespace {
@@ -63,57 +65,55 @@ double cutting_radius(double u, double v, double c, double cap) {
 void Sharpener::judge_chains() {
   const size_t m = nv.size();
   std::vector<uint8_t> rejected(m, 0);
-  if (o.passes.on(Pass::round_chains)) {
-    std::vector<uint32_t> chain(m, kNone), members, near;
-    for (uint32_t i0 = 0; i0 < m; ++i0) {
-      if (nv[i0].corner || chain[i0] != kNone) continue;
-      members.assign(1, i0);  // the chain: a walk over the new edges, corners left out
-      chain[i0] = i0;
-      for (size_t k = 0; k < members.size(); ++k) {
-        const uint32_t i = members[k];
-        for (int e = 0; e < std::min<int>(chain_degree[i], 2); ++e) {
-          const uint32_t j = chain_nb[i][size_t(e)] - uint32_t(n);
-          if (!nv[j].corner && chain[j] == kNone) chain[j] = i0, members.push_back(j);
-        }
+  std::vector<uint32_t> chain(m, kNone), members, near;
+  for (uint32_t i0 = 0; i0 < m; ++i0) {
+    if (nv[i0].corner || chain[i0] != kNone) continue;
+    members.assign(1, i0);  // the chain: a walk over the new edges, corners left out
+    chain[i0] = i0;
+    for (size_t k = 0; k < members.size(); ++k) {
+      const uint32_t i = members[k];
+      for (int e = 0; e < std::min<int>(chain_degree[i], 2); ++e) {
+        const uint32_t j = chain_nb[i][size_t(e)] - uint32_t(n);
+        if (!nv[j].corner && chain[j] == kNone) chain[j] = i0, members.push_back(j);
       }
-      const double cap = 16;  // cells: no sample bounds the rounding at all (leaning planes, not a fillet)
-      double allow = cap;
-      bool demanded = false;
-      for (uint32_t i : members) {
-        const NewVertex& v = nv[i];
-        const Plane* pa = plane_of(v.a);
-        const Plane* pb = plane_of(v.b);
-        if (!pa || !pb) continue;
-        const double sa = pa->n.dot(x[v.b]) - pa->c, sb = pb->n.dot(x[v.a]) - pb->c;
-        const int kind = sa < 0 && sb < 0 ? 1 : sa > 0 && sb > 0 ? -1 : 0;  // convex, concave, undecided
-        if (kind == 0) continue;
-        const double c = pa->n.dot(pb->n);
-        near.clear();
-        for (uint32_t e : {v.a, v.b}) {
-          near.push_back(e);
-          for (uint32_t k = adj_off[e]; k < adj_off[e + 1]; ++k)
-            if (label[adj[k]] == label[v.a] || label[adj[k]] == label[v.b]) near.push_back(adj[k]);
-        }
-        for (uint32_t q : near) {
-          const Vec3 keep = kind > 0 ? s.inside_sample(q) : s.outside_sample(q);
-          const double r = cutting_radius(-kind * (pa->n.dot(keep) - pa->c), -kind * (pb->n.dot(keep) - pb->c), c, cap);
-          allow = std::min(allow, r);
-          const Vec3 gone = kind > 0 ? s.outside_sample(q) : s.inside_sample(q);
-          const double da = pa->n.dot(gone) - pa->c, db = pb->n.dot(gone) - pb->c;
-          demanded |= (kind > 0 ? std::min(-da, -db) : std::min(da, db)) > detail::kRoundEvidence;
-        }
-      }
-      if (!demanded || allow < detail::kRoundRadius || allow == cap) continue;
-      ++st.round_chains;
-      for (uint32_t i : members) nv[i].moves = nv[i].sharp = false, rejected[i] = 1;
     }
-    for (uint32_t i = 0; i < m; ++i)
-      if (nv[i].corner) {
-        bool all = true;
-        for (uint32_t e : nv[i].from) all &= e != kNone && rejected[e - n];
-        if (all) nv[i].moves = nv[i].sharp = false;
+    const double cap = 16;  // cells: no sample bounds the rounding at all (leaning planes, not a fillet)
+    double allow = cap;
+    bool demanded = false;
+    for (uint32_t i : members) {
+      const NewVertex& v = nv[i];
+      const Plane* pa = plane_of(v.a);
+      const Plane* pb = plane_of(v.b);
+      if (!pa || !pb) continue;
+      const double sa = pa->n.dot(x[v.b]) - pa->c, sb = pb->n.dot(x[v.a]) - pb->c;
+      const int kind = sa < 0 && sb < 0 ? 1 : sa > 0 && sb > 0 ? -1 : 0;  // convex, concave, undecided
+      if (kind == 0) continue;
+      const double c = pa->n.dot(pb->n);
+      near.clear();
+      for (uint32_t e : {v.a, v.b}) {
+        near.push_back(e);
+        for (uint32_t k = adj_off[e]; k < adj_off[e + 1]; ++k)
+          if (label[adj[k]] == label[v.a] || label[adj[k]] == label[v.b]) near.push_back(adj[k]);
       }
+      for (uint32_t q : near) {
+        const Vec3 keep = kind > 0 ? s.inside_sample(q) : s.outside_sample(q);
+        const double r = cutting_radius(-kind * (pa->n.dot(keep) - pa->c), -kind * (pb->n.dot(keep) - pb->c), c, cap);
+        allow = std::min(allow, r);
+        const Vec3 gone = kind > 0 ? s.outside_sample(q) : s.inside_sample(q);
+        const double da = pa->n.dot(gone) - pa->c, db = pb->n.dot(gone) - pb->c;
+        demanded |= (kind > 0 ? std::min(-da, -db) : std::min(da, db)) > detail::kRoundEvidence;
+      }
+    }
+    if (!demanded || allow < detail::kRoundRadius || allow == cap) continue;
+    ++st.round_chains;
+    for (uint32_t i : members) nv[i].moves = nv[i].sharp = false, rejected[i] = 1;
   }
+  for (uint32_t i = 0; i < m; ++i)
+    if (nv[i].corner) {
+      bool all = true;
+      for (uint32_t e : nv[i].from) all &= e != kNone && rejected[e - n];
+      if (all) nv[i].moves = nv[i].sharp = false;
+    }
   // The rim pockets within kCreaseRings rings of a chain left round, on no
   // kept crease's edge, go back where they were before join_leftovers slid
   // them onto their flat's plane (along a fillet tangent to the flat the
@@ -146,3 +146,13 @@ void Sharpener::judge_chains() {
 }
 
 }  // namespace voxpress::sharpen_impl
+
+namespace voxpress::detail {
+
+size_t round_chains_step(FeatureContext& c) {
+  if (c.sharpen->nv.empty()) return 0;
+  c.sharpen->judge_chains();  // before the moves' index(): it may slide rim pockets
+  return c.sharpen->st.round_chains;
+}
+
+}  // namespace voxpress::detail

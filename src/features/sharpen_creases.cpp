@@ -1,6 +1,8 @@
 // Sharpening: thin walls, the final crease fit, vertices past their crease, curved creases.
 // Theory of operation: sharpener.h and include/voxpress/features/sharpen.h.
 #include "sharpener.h"
+
+#include "feature_context.h"
 #include "core/parallel.h"
 
 namespace voxpress::sharpen_impl {
@@ -184,7 +186,6 @@ void fit_wall_planes(const Sharpener& sh, const Walls& W, std::vector<Plane>& wa
 }  // namespace
 
 void Sharpener::fit_walls() {
-  if (!o.passes.on(Pass::walls)) return;
   std::vector<uint32_t> fresh;
   const std::vector<Near> near = flats_near(*this, fresh);
   const Walls W = wall_candidates(*this, fresh, near);
@@ -275,7 +276,6 @@ uint32_t Sharpener::add_vertex(const NewVertex& v, const Vec3& at) {
 }
 
 void Sharpener::final_crease_fit() {
-  if (!o.passes.on(Pass::final_crease)) return;
   const detail::CreaseFit c{.rings = detail::kFinalCreaseRings,
                             .fit_rings = detail::kFinalCreaseFitRings,
                             .residual = detail::kFinalCreaseResidual,
@@ -297,7 +297,6 @@ int Sharpener::crease_kind_near(uint32_t v, int32_t f, std::vector<uint32_t>& ri
 }
 
 void Sharpener::past_creases() {
-  if (!o.passes.on(Pass::past_crease)) return;
   struct Move {
     uint32_t v;
     int32_t label;  // the flat it joins, or -1 (it leaves its flat)
@@ -355,8 +354,6 @@ void Sharpener::past_creases() {
 }
 
 void Sharpener::curved_creases() {
-  crease_side.assign(n, 0);
-  if (!o.passes.on(Pass::curved_creases)) return;
   detail::CurvedCreaseFit c;
   c.sharp_angle = o.sharp_angle;
   c.margin = o.margin;
@@ -396,3 +393,27 @@ void Sharpener::curved_creases() {
 }
 
 }  // namespace voxpress::sharpen_impl
+
+namespace voxpress::detail {
+
+size_t walls_step(FeatureContext& c) {
+  c.sharpen->fit_walls();
+  return c.sharpen->st.wall_vertices;
+}
+
+size_t final_crease_step(FeatureContext& c) {
+  c.sharpen->final_crease_fit();
+  return c.sharpen->st.final_crease_vertices;
+}
+
+size_t past_crease_step(FeatureContext& c) {
+  c.sharpen->past_creases();
+  return c.sharpen->st.past_crease + c.sharpen->st.left_flat;
+}
+
+size_t final_curved_creases_step(FeatureContext& c) {
+  c.sharpen->curved_creases();
+  return c.sharpen->st.curved_crease_vertices;
+}
+
+}  // namespace voxpress::detail

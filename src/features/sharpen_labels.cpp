@@ -1,6 +1,8 @@
 // Sharpening: the regions (leftovers, strips, snapped bands, junctions) and each side's plane.
 // Theory of operation: sharpener.h and include/voxpress/features/sharpen.h.
 #include "sharpener.h"
+
+#include "feature_context.h"
 #include "core/parallel.h"
 
 namespace voxpress::sharpen_impl {
@@ -99,7 +101,6 @@ void Sharpener::thin_strips(std::vector<uint8_t>& mark) {
 }
 
 void Sharpener::snap_to_flats() {
-  if (!o.passes.on(Pass::snap)) return;
   // Candidates: curved vertices, and members up to 2 rings from a border.
   const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, 2, adj_off, adj);
   std::vector<int32_t> flat(n, -1);  // the flat whose plane the solid crosses v's stick on
@@ -215,7 +216,6 @@ void Sharpener::join_leftovers() {
 }
 
 void Sharpener::inherit_junctions() {
-  if (!o.passes.on(Pass::inherit_junctions)) return;
   std::vector<uint32_t> heirs;
   for (uint32_t v = 0; v < n; ++v)
     if (label[v] >= 0 && seg.region[v] < 0 && junction[v] && std::abs(height(label[v], x[v])) <= kPastSample)
@@ -252,3 +252,22 @@ size_t Sharpener::mark_junctions(const std::vector<uint32_t>& vertices) {
 }
 
 }  // namespace voxpress::sharpen_impl
+
+namespace voxpress::detail {
+
+size_t snap_step(FeatureContext& c) {
+  c.sharpen->snap_to_flats();
+  return c.sharpen->st.snapped;
+}
+
+size_t leftovers_step(FeatureContext& c) {
+  c.sharpen->join_leftovers();
+  return c.sharpen->leftovers.size();  // the strips and rim pockets count themselves
+}
+
+size_t inherit_junctions_step(FeatureContext& c) {
+  c.sharpen->inherit_junctions();
+  return c.sharpen->st.inherited_junctions;
+}
+
+}  // namespace voxpress::detail

@@ -2,6 +2,8 @@
 // Theory of operation: sharpener.h and include/voxpress/features/sharpen.h.
 #include "sharpener.h"
 
+#include "feature_context.h"
+
 namespace voxpress::sharpen_impl {
 
 void Sharpener::subdivide() {
@@ -313,3 +315,14 @@ void Sharpener::smooth_chains() {
 }
 
 }  // namespace voxpress::sharpen_impl
+
+namespace voxpress::detail {
+
+size_t sharpen_step(FeatureContext& c) {
+  sharpen_impl::Sharpener& sh = *c.sharpen;
+  sh.subdivide();
+  if (!sh.nv.empty()) sh.build_chains();
+  return sh.st.inserted;
+}
+
+}  // namespace voxpress::detail

@@ -1,8 +1,9 @@
 // Private to the sharpening (Section 5): the Sharpener — the state of one
-// sharpen() call and its steps, split over sharpen_labels.cpp (regions and
-// planes), sharpen_creases.cpp (walls, crease fits, curved creases),
-// sharpen_moves.cpp (subdivision and the checked move) and sharpen.cpp (the
-// run and the output). Index space throughout. Theory of operation:
+// sharpen() call, on which Stage::sharpen's passes run (the table in
+// passes.cpp; their steps beside their code): sharpen_labels.cpp (regions
+// and planes), sharpen_creases.cpp (walls, crease fits, curved creases),
+// sharpen_moves.cpp (subdivision and the checked move), sharpen_chains.cpp
+// (round chains) and sharpen.cpp (the run, the moves and the output). Index space throughout. Theory of operation:
 // include/voxpress/features/sharpen.h.
 #pragma once
 
@@ -163,7 +164,7 @@ struct Sharpener {
   // tangent plane where v projects onto it; v is next to the crease, so that
   // plane's line with the flat is within ~ (0.5 cell)^2 / 2R of it.
   bool tangent_plane(uint32_t v, Plane& out) {
-    if (!o.passes.on(Pass::tangent_planes)) return false;
+    if (!o.passes.on(Pass::tangent_planes)) return false;  // a rule
     detail::rings_around(v, uint32_t(detail::kCurvedFitRings), adj_off, adj, [&](uint32_t w) { return label[w] < 0; }, rings);
     std::vector<Vec3> pts;
     Vec3 outward = Vec3::Zero();
@@ -579,7 +580,12 @@ struct Sharpener {
   // bilaplacian, moving across the chain only and within a flat's plane.
   void smooth_chains();
 
+  // Stage::sharpen's passes (the table in passes.cpp), then the output.
   SharpenResult run();
+  // The moves pass: the leftovers onto their flats, the new vertices onto
+  // their creases (each move checked), then the chains smoothed; returns
+  // the moves that reached their target.
+  size_t move_all();
 
   Mesh output() const;
 };

@@ -6,6 +6,7 @@
 
 #include "core/clearance.h"
 #include "core/timing.h"
+#include "features/feature_context.h"
 #include "io/io_util.h"
 
 namespace voxpress {
@@ -149,11 +150,12 @@ void press_on_own_box(StickSurface& surface, const SurfaceOptions& o, SurfaceRes
   const FeaturePressStats fs = press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats);
   r.press = fs.press;
   r.pass_times = fs.passes;
-  QuadricFitOptions qo = o.fit;
-  qo.margin = po.margin;
-  if (!on.on(Pass::quadric_fit)) qo.rings = 0;
-  r.fit = fit_local_quadrics(surface, r.flats.region, r.flats.junction, qo);
-  r.pass_times.add(Pass::quadric_fit, r.fit.seconds, r.fit.moved);
+  detail::FitStage fit{surface, r.flats, o.fit, {}};
+  fit.o.margin = po.margin;
+  detail::FeatureContext fc{on, r.pass_times};
+  fc.fit = &fit;
+  detail::run_stage(Stage::fit, fc);
+  r.fit = fit.out;
 }
 
 }  // namespace

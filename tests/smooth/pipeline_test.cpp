@@ -128,6 +128,8 @@ TEST(Passes, TableIsInRunningOrderAndNamesRoundTrip) {
     EXPECT_EQ(size_t(passes[i].pass), i) << passes[i].name;
     EXPECT_EQ(parse_pass(passes[i].name), passes[i].pass);
     EXPECT_STRNE(passes[i].section, "");
+    if (i > 0) EXPECT_GE(passes[i].stage, passes[i - 1].stage) << passes[i].name;  // stages in pipeline order
+    if (passes[i].needs != Pass::count) EXPECT_LT(size_t(passes[i].needs), i) << passes[i].name;
   }
   EXPECT_THROW(parse_pass("no-such-pass"), UsageError);
   PassSet s;
@@ -136,6 +138,59 @@ TEST(Passes, TableIsInRunningOrderAndNamesRoundTrip) {
   EXPECT_FALSE(s.on(Pass::walls));
   EXPECT_TRUE(s.on(Pass::snap));
   EXPECT_EQ(s.disabled(), (std::vector<std::string>{"flats", "walls"}));
+}
+
+// The driver's trace, cut where the table index stops increasing, is a
+// sequence of stage runs; each must be exactly its stage's steps that
+// runs() allows, in table order, and the stages must come in pipeline
+// order (detection rounds, crease rounds, fit, sharpening).
+void expect_trace_follows_table(const std::vector<Pass>& trace, const PassSet& on) {
+  const auto& table = feature_passes();
+  std::vector<std::vector<Pass>> runs_of_stage;
+  for (size_t i = 0; i < trace.size(); ++i) {
+    if (i == 0 || size_t(trace[i]) <= size_t(trace[i - 1]) || table[size_t(trace[i])].stage != table[size_t(trace[i - 1])].stage)
+      runs_of_stage.emplace_back();
+    runs_of_stage.back().push_back(trace[i]);
+  }
+  ASSERT_FALSE(runs_of_stage.empty());
+  Stage last = Stage::detect;
+  for (const std::vector<Pass>& r : runs_of_stage) {
+    const Stage stage = table[size_t(r.front())].stage;
+    EXPECT_GE(stage, last);
+    last = stage;
+    std::vector<Pass> expected;
+    for (const PassInfo& p : table)
+      if (p.stage == stage && p.run && runs(p, on)) expected.push_back(p.pass);
+    EXPECT_EQ(r, expected) << "stage " << int(stage);
+  }
+}
+
+TEST(Passes, TheDriverRunsEachStageInTableOrder) {
+  // A rotated CAD part has flats, junctions (crease rounds) and creases:
+  // every stage runs. Switched-off passes leave the trace, and a pass whose
+  // `needs` is off does too.
+  GenerateOptions g;
+  g.res = 40;
+  g.rotation = parse_rotation("random:3");
+  const GeneratedShape part = generate_shape(ShapeKind::cad_part, g);
+  for (const char* off : {"", "snap", "curved-creases", "junctions", "moves"}) {
+    SCOPED_TRACE(off);
+    SurfaceOptions o;
+    if (*off) o.passes.disable(off);
+    const SurfaceResult r = smooth_surface(part.volume, o);
+    const std::vector<Pass>& trace = r.pass_times.trace;
+    expect_trace_follows_table(trace, o.passes);
+    for (Stage st : {Stage::detect, Stage::crease_round, Stage::fit, Stage::sharpen}) {
+      if (st == Stage::crease_round && !o.passes.on(Pass::junctions)) continue;  // no junction, no crease round
+      EXPECT_TRUE(std::any_of(trace.begin(), trace.end(), [&](Pass p) { return feature_passes()[size_t(p)].stage == st; }))
+          << "stage " << int(st) << " never ran";
+    }
+    if (*off) {
+      const Pass p = parse_pass(off);
+      EXPECT_EQ(std::count(trace.begin(), trace.end(), p), 0);
+      if (p == Pass::curved_creases) EXPECT_EQ(std::count(trace.begin(), trace.end(), Pass::final_curved_creases), 0);
+    }
+  }
 }
 
 TEST(Passes, EachPassOffKeepsTheGuarantees) {

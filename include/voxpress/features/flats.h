@@ -113,11 +113,10 @@ struct FlatStats {
   size_t crease_vertices = 0;  ///< vertices fit_creases placed (last round)
   size_t curved_crease_vertices = 0;  ///< vertices fit_curved_creases placed (last round)
   double seconds_creases = 0;  ///< all rounds of fit_creases and fit_curved_creases
-  /// The detection's passes (stab-refit, curved-test, merge, tangent-borders,
-  /// ring-off-plane, crease-refit, center-planes, rim-tangent): what each
+  /// Stage::detect's passes and rules (flats ... rim-tangent): what each
   /// changed in the last detection (cores refit, flats refused or merged,
   /// borders judged smooth, junction planes, planes refit or centred, rim
-  /// vertices given back) and the seconds of those timed on their own.
+  /// vertices given back), the seconds of every detection, and the trace.
   PassTimes passes;
 };
 
@@ -162,7 +161,7 @@ size_t fit_curved_creases(StickSurface& surface, const FlatSegmentation& flats, 
 struct FeaturePressStats {
   PressStats press;  ///< the final press (seconds 0 when it is the first estimate, kept)
   FlatStats flats;
-  PassTimes passes;  ///< flats, crease_fit and curved_creases (press time), with their counts
+  PassTimes passes;  ///< the detection's and the crease rounds' passes (press time), with their counts and trace
 };
 
 /// The flats and junctions of `surface` from its estimates (the first half

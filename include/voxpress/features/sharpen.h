@@ -93,7 +93,7 @@ struct SharpenStats {
   size_t round_chains = 0;            ///< chains left round: their samples allow a fillet the lattice resolves
   size_t cut_back = 0;                ///< moves shortened to keep the guarantee or the mesh valid
   size_t sharp_edges = 0;             ///< labelled sharp edges (mesh.edges)
-  PassTimes passes;                   ///< per pass (the base steps as Pass::sharpen)
+  PassTimes passes;                   ///< Stage::sharpen's passes (setup and output as Pass::sharpen), and the trace
   double seconds = 0;
 };
 

@@ -1,0 +1,75 @@
+// Private to the feature layer: its driver. The pass table
+// (features/passes.cpp, declared in voxpress/features/passes.h) lists every
+// pass with its stage and its step; run_stage runs one stage's steps in
+// table order over the stage's context, each only when runs() allows it,
+// and times, counts and traces each. A step returns its count; what a
+// step records itself in `times` (its rules' seconds) is not counted twice.
+#pragma once
+
+#include <vector>
+
+#include "voxpress/features/flats.h"
+#include "voxpress/smooth/pressing.h"
+
+namespace voxpress::flats_impl {
+struct FlatsContext;  // flat_detector.h
+}
+namespace voxpress::sharpen_impl {
+struct Sharpener;  // sharpener.h
+}
+
+namespace voxpress::detail {
+
+// Stage::crease_round's state (feature_press.cpp): the surface pressed so
+// far, its flats, and what the round's placements fix and cut.
+struct CreaseRound {
+  StickSurface& s;
+  FlatSegmentation& seg;
+  const FlatOptions& o;
+  std::vector<uint8_t> fixed;    // placed by crease_fit, then curved_creases
+  std::vector<uint8_t> barrier;  // seg.barrier and the curved creases' vertices
+  bool last = false;             // the last round: the one whose counts are reported
+};
+
+// Stage::fit's state.
+struct FitStage {
+  StickSurface& s;
+  const FlatSegmentation& seg;
+  QuadricFitOptions o;
+  QuadricFitStats out;
+};
+
+// The state a stage's steps work on: the stage's own (one of the pointers)
+// and where the driver writes.
+struct FeatureContext {
+  const PassSet& on;
+  PassTimes& times;
+  flats_impl::FlatsContext* detect = nullptr;   // Stage::detect
+  CreaseRound* crease = nullptr;                // Stage::crease_round
+  FitStage* fit = nullptr;                      // Stage::fit
+  sharpen_impl::Sharpener* sharpen = nullptr;   // Stage::sharpen
+};
+
+// Runs `stage`'s steps, in table order.
+void run_stage(Stage stage, FeatureContext& ctx);
+
+// The steps, each defined beside its pass's code (the table names them).
+size_t flats_step(FeatureContext&);              // find_flats.cpp: votes and greedy growth
+size_t merge_step(FeatureContext&);              // find_flats.cpp
+size_t junctions_step(FeatureContext&);          // flat_junctions.cpp: extension to the sharp edges
+size_t rim_tangent_step(FeatureContext&);        // flat_junctions.cpp
+size_t crease_fit_step(FeatureContext&);         // feature_press.cpp
+size_t curved_creases_step(FeatureContext&);     // feature_press.cpp
+size_t quadric_fit_step(FeatureContext&);        // feature_press.cpp
+size_t snap_step(FeatureContext&);               // sharpen_labels.cpp
+size_t leftovers_step(FeatureContext&);          // sharpen_labels.cpp
+size_t inherit_junctions_step(FeatureContext&);  // sharpen_labels.cpp
+size_t walls_step(FeatureContext&);              // sharpen_creases.cpp
+size_t final_crease_step(FeatureContext&);       // sharpen_creases.cpp
+size_t past_crease_step(FeatureContext&);        // sharpen_creases.cpp
+size_t final_curved_creases_step(FeatureContext&);  // sharpen_creases.cpp
+size_t sharpen_step(FeatureContext&);            // sharpen_moves.cpp: the chamfers split
+size_t round_chains_step(FeatureContext&);       // sharpen_chains.cpp
+size_t moves_step(FeatureContext&);              // sharpen.cpp
+
+}  // namespace voxpress::detail
