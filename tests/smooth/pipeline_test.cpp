@@ -128,8 +128,12 @@ TEST(Passes, TableIsInRunningOrderAndNamesRoundTrip) {
     EXPECT_EQ(size_t(passes[i].pass), i) << passes[i].name;
     EXPECT_EQ(parse_pass(passes[i].name), passes[i].pass);
     EXPECT_STRNE(passes[i].section, "");
-    if (i > 0) EXPECT_GE(passes[i].stage, passes[i - 1].stage) << passes[i].name;  // stages in pipeline order
-    if (passes[i].needs != Pass::count) EXPECT_LT(size_t(passes[i].needs), i) << passes[i].name;
+    if (i > 0) {
+      EXPECT_GE(passes[i].stage, passes[i - 1].stage) << passes[i].name;  // stages in pipeline order
+    }
+    if (passes[i].needs != Pass::count) {
+      EXPECT_LT(size_t(passes[i].needs), i) << passes[i].name;
+    }
   }
   EXPECT_THROW(parse_pass("no-such-pass"), UsageError);
   PassSet s;
@@ -188,7 +192,9 @@ TEST(Passes, TheDriverRunsEachStageInTableOrder) {
     if (*off) {
       const Pass p = parse_pass(off);
       EXPECT_EQ(std::count(trace.begin(), trace.end(), p), 0);
-      if (p == Pass::curved_creases) EXPECT_EQ(std::count(trace.begin(), trace.end(), Pass::final_curved_creases), 0);
+      if (p == Pass::curved_creases) {
+        EXPECT_EQ(std::count(trace.begin(), trace.end(), Pass::final_curved_creases), 0);
+      }
     }
   }
 }
