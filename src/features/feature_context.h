@@ -1,6 +1,7 @@
 // Private to the feature layer: its driver. The pass table
 // (features/passes.cpp, declared in voxpress/features/passes.h) lists every
-// pass with its stage and its step; run_stage runs one stage's steps in
+// pass with its stage and its step (each step defined beside its pass's
+// code, declared beside its row); run_stage runs one stage's steps in
 // table order over the stage's context, each only when runs() allows it,
 // and times, counts and traces each. A step returns its count; what a
 // step records itself in `times` (its rules' seconds) is not counted twice.
@@ -52,24 +53,5 @@ struct FeatureContext {
 
 // Runs `stage`'s steps, in table order.
 void run_stage(Stage stage, FeatureContext& ctx);
-
-// The steps, each defined beside its pass's code (the table names them).
-size_t flats_step(FeatureContext&);              // find_flats.cpp: votes and greedy growth
-size_t merge_step(FeatureContext&);              // find_flats.cpp
-size_t junctions_step(FeatureContext&);          // flat_junctions.cpp: extension to the sharp edges
-size_t rim_tangent_step(FeatureContext&);        // flat_junctions.cpp
-size_t crease_fit_step(FeatureContext&);         // feature_press.cpp
-size_t curved_creases_step(FeatureContext&);     // feature_press.cpp
-size_t quadric_fit_step(FeatureContext&);        // feature_press.cpp
-size_t snap_step(FeatureContext&);               // sharpen_labels.cpp
-size_t leftovers_step(FeatureContext&);          // sharpen_labels.cpp
-size_t inherit_junctions_step(FeatureContext&);  // sharpen_labels.cpp
-size_t walls_step(FeatureContext&);              // sharpen_creases.cpp
-size_t final_crease_step(FeatureContext&);       // sharpen_creases.cpp
-size_t past_crease_step(FeatureContext&);        // sharpen_creases.cpp
-size_t final_curved_creases_step(FeatureContext&);  // sharpen_creases.cpp
-size_t sharpen_step(FeatureContext&);            // sharpen_moves.cpp: the chamfers split
-size_t round_chains_step(FeatureContext&);       // sharpen_chains.cpp
-size_t moves_step(FeatureContext&);              // sharpen.cpp
 
 }  // namespace voxpress::detail

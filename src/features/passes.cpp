@@ -13,6 +13,27 @@ namespace voxpress {
 
 using detail::seconds_since;
 
+namespace detail {
+// The steps, each defined in its pass's file.
+size_t flats_step(FeatureContext&);              // find_flats.cpp: votes and greedy growth
+size_t merge_step(FeatureContext&);              // find_flats.cpp
+size_t junctions_step(FeatureContext&);          // flat_junctions.cpp: extension to the sharp edges
+size_t rim_tangent_step(FeatureContext&);        // flat_junctions.cpp
+size_t crease_fit_step(FeatureContext&);         // feature_press.cpp
+size_t curved_creases_step(FeatureContext&);     // feature_press.cpp
+size_t quadric_fit_step(FeatureContext&);        // feature_press.cpp
+size_t snap_step(FeatureContext&);               // sharpen_labels.cpp
+size_t leftovers_step(FeatureContext&);          // sharpen_labels.cpp
+size_t inherit_junctions_step(FeatureContext&);  // sharpen_labels.cpp
+size_t walls_step(FeatureContext&);              // sharpen_walls.cpp
+size_t final_crease_step(FeatureContext&);       // sharpen_creases.cpp
+size_t past_crease_step(FeatureContext&);        // sharpen_creases.cpp
+size_t final_curved_creases_step(FeatureContext&);  // sharpen_creases.cpp
+size_t sharpen_step(FeatureContext&);            // sharpen_moves.cpp: the chamfers split
+size_t round_chains_step(FeatureContext&);       // sharpen_chains.cpp
+size_t moves_step(FeatureContext&);              // sharpen.cpp
+}  // namespace detail
+
 using detail::FeatureContext;
 using S = Stage;
 

@@ -79,7 +79,6 @@ struct NewVertex {
   std::array<uint32_t, 3> from{kNone, kNone, kNone};  // corner: its three edge vertices
 };
 
-struct Walls;  // sharpen_creases.cpp: the candidates of thin walls
 
 struct Sharpener {
   const StickSurface& s;
@@ -96,7 +95,7 @@ struct Sharpener {
   std::vector<uint32_t> leftovers;          // curved junction vertices that joined a flat
   std::vector<uint8_t> junction;            // per original vertex: seg.junction, and the rim pockets' (join_leftovers)
   std::vector<int8_t> plane_state;          // per original vertex: 0 unknown, 1 has plane, -1 none
-  std::vector<uint8_t> on_wall;             // per original vertex: 1 placed on a thin wall's plane (fit_walls)
+  std::vector<uint8_t> on_wall;             // per original vertex: 1 placed on a thin wall's plane (sharpen_walls.cpp)
   std::vector<Plane> plane;
   detail::RingScratch rings;                // scratch of rings_around (tangent_plane, thin_strips)
   std::vector<uint32_t> fan_off, fan;       // triangles around each vertex (CSR)
@@ -344,46 +343,6 @@ struct Sharpener {
   int32_t nearest_neighbour_flat(uint32_t v, double& distance) const;
   // Makes them junctions; returns how many were not yet.
   size_t mark_junctions(const std::vector<uint32_t>& vertices);
-
-  // Beyond the paper: thin walls. A plate a few cells thick has its rim
-  // between two nearly opposite flats; the rim's fresh vertices are all
-  // junctions with too few fresh neighbours for a plane of their own, so they
-  // joined the flats (join_leftovers), and the chamfer between two parallel
-  // planes has no line: one crease was labelled along the middle of the rim,
-  // a cell from both true edges (1002_tray_bottom at 256^3: none of its
-  // sharp length within half a voxel of a label). A fresh vertex reached,
-  // over fresh vertices, from members of two flats A, B whose normals are at
-  // least 170 degrees apart (a plate's faces; 150 also took fandisk's curved
-  // faces between its two nearly opposite sides), and lying between their
-  // planes at most `wall_thickness` cells apart, is on such a wall; beyond
-  // 12 cells the samples resolve the wall's own surface, and its 2-ring
-  // plane must be within 10 degrees of perpendicular to the flats (on
-  // fandisk's curved faces it is not: without this test a bound of 24 took
-  // them, r->t 0.0732 -> 0.0762 at 128^3). Its
-  // plane: the widest separator of the inside samples of the sticks of the
-  // wall vertices within 2 rings (over wall vertices) from those sticks'
-  // outside samples that lie between A's and B's planes (outside because of
-  // the wall, not of a flat): a maximum-margin line in the plane
-  // perpendicular to A's normal, searched over its angle, c in the middle of
-  // the margin (the centre of the feasible set, like the flats' centring).
-  // Where no line separates them (the rim turns: the tray's corners, small
-  // holes) the 1-ring's samples are used. The pressed rim is no guide:
-  // squeezed between the flats, its vertices sit up to a cell inside. The
-  // vertex then slides along its stick onto that plane when its own outside
-  // sample is between A and B, and becomes a curved junction whose plane is
-  // the wall's, so the chamfers on both sides cut along wall ∩ A and wall ∩
-  // B. Fixed 2- or 3-ring fits were measured worse than 1 ring (their
-  // infeasible fits left vertices out); 3 rings first, then 2 and 1, is no
-  // better than 2 then 1 (measured with `build/bench/bench_ablation --cases
-  // plate_holes.STL,thingi10k-65004.stl --passes walls`). Rim vertices on a flat's
-  // stick (its outside sample above a face) that joined a flat, and the
-  // flats' own vertices next to the wall, go where their stick first leaves
-  // the solid, through the wall or the flat; left on a flat mid-rim, they
-  // kinked it.
-  void fit_walls();
-  // fit_walls' last step: each fitted wall's vertices onto its plane, flat
-  // vertices whose stick leaves through it too.
-  void place_walls(const Walls& W, const std::vector<Plane>& wall, const std::vector<uint8_t>& ok);
 
   uint32_t add_vertex(const NewVertex& v, const Vec3& at);
 
