@@ -228,6 +228,7 @@ nlohmann::json simplify_stats_json(const SimplifyStats& st, const SimplifyOption
   return {{"faces_target", o.faces},          {"max_error", o.max_error},
           {"faces_before", st.faces_before},  {"faces", st.faces_after},
           {"vertices", st.vertices_after},    {"collapses", st.collapses},
+          {"in_plane", st.in_plane},
           {"error", st.error},
           {"refused", {{"topology", st.refused_topology}, {"shape", st.refused_shape}, {"samples", st.refused_samples},
                        {"clash", st.refused_clash}, {"error", st.refused_error}}},

@@ -491,6 +491,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
         }
       }
       apply(m, c.probe);
+      st.in_plane += c.probe.planar;
       applied.emplace_back(c.probe.lo, c.probe.hi);
       kept.push_back(m.v);
     }

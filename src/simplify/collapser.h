@@ -65,6 +65,7 @@ class Collapser {
     std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face)
     std::vector<std::pair<uint64_t, int>> hits;  // samples_ok's swept samples: (sample key, sign)
     Vec3 lo, hi;
+    bool planar = false;  // the last check proved the move inside one plane (in_plane)
     bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
   };
   enum class Verdict : uint8_t { ok, topology, shape, error, samples, clash };
@@ -101,6 +102,7 @@ class Collapser {
   bool error_ok(const Move& m, Probe& p) const;
   bool samples_ok(const Move& m, const Vec3& qi, Probe& p) const;
   bool clash_free(const Move& m, const Vec3& qi, Probe& p) const;
+  bool in_plane(const Move& m, const Vec3& qi, Probe& p) const;
   void box_of(uint32_t f, Vec3& lo, Vec3& hi) const;
   Vec3 at_index(uint32_t w, const Move& m, const Vec3& qi) const { return w == m.u || w == m.v ? qi : xi[w]; }
   Vec3 at_phys(uint32_t w, const Move& m) const { return w == m.u || w == m.v ? m.q : xp[w]; }

@@ -49,6 +49,7 @@ struct SimplifyOptions {
 struct SimplifyStats {
   uint64_t faces_before = 0, faces_after = 0, vertices_after = 0;
   uint64_t collapses = 0;
+  uint64_t in_plane = 0;  ///< of those, proven inside one plane (no clash query needed)
   /// Candidate collapses refused, by the first check that failed.
   uint64_t refused_topology = 0;  ///< link condition, a tetrahedron, a feature rule
   uint64_t refused_shape = 0;     ///< a face would turn over, degenerate or be thinner than the clearance
