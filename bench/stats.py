@@ -3,7 +3,7 @@
 `voxpress press|extract --stats-json FILE.json` as Markdown rows
 (docs/BENCHMARKS.md): seconds per stage ("seconds"), the flats' own stages
 (estimate, detect, junctions, creases), the simplification's seconds and
-faces (with --faces), the stick count, labelled sharp edges and peak memory; with --passes, each feature pass's seconds and count too.
+faces and the collapses inside one plane (with --faces), the stick count, labelled sharp edges and peak memory; with --passes, each feature pass's seconds and count too.
     python3 bench/stats.py --passes out/bench/sphere-2.json out/bench/cad-2.json
 """
 import argparse
@@ -23,7 +23,7 @@ def main():
     stages = sorted({k for _, s in stats for k in s.get("seconds", {})}, key=lambda k: (k != "total", k))
     flats = sorted({k for _, s in stats for k in s.get("flats", {}).get("seconds", {})})
     simp = any("simplify" in s for _, s in stats)
-    head = ["file", *stages, *("flats: " + k for k in flats), *(["simplify", "faces"] if simp else []),
+    head = ["file", *stages, *("flats: " + k for k in flats), *(["simplify", "faces", "in one plane"] if simp else []),
             "stick count", "sharp edges", "peak MB"]
     print(row(head))
     print(row(["---"] + ["---:"] * (len(head) - 1)))
@@ -33,7 +33,7 @@ def main():
         print(row([f, *(f"{sec[k]:.2f}" if k in sec else "" for k in stages),
                    *(f"{fsec[k]:.2f}" if k in fsec else "" for k in flats),
                    *([f"{s['simplify']['seconds']:.2f}" if "simplify" in s else "",
-                      s.get("simplify", {}).get("faces", "")] if simp else []),
+                      s.get("simplify", {}).get("faces", ""), s.get("simplify", {}).get("in_plane", "")] if simp else []),
                    s.get("counts", {}).get("sticks", ""), s.get("sharpen", {}).get("sharp_edges", ""),
                    f"{peak / 2**20:.0f}" if peak else ""]))
     if args.passes:

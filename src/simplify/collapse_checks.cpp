@@ -106,8 +106,8 @@ Collapser::Verdict Collapser::check(const Move& m, Probe& p) const {
   std::set_union(vf[m.u].begin(), vf[m.u].end(), vf[m.v].begin(), vf[m.v].end(), std::back_inserter(p.ring));
   if (!shape_ok(m, qi, p)) return Verdict::shape;
   if (!error_ok(m, p)) return Verdict::error;
+  if (in_plane(m, qi, p)) return Verdict::ok;  // proven: no sample nor face can have come nearer
   if (!samples_ok(m, qi, p)) return Verdict::samples;
-  if (in_plane(m, qi, p)) return Verdict::ok;  // proven: no face can have come nearer
   if (!clash_free(m, qi, p)) return Verdict::clash;
   return Verdict::ok;
 }
@@ -119,9 +119,10 @@ Collapser::Verdict Collapser::check(const Move& m, Probe& p) const {
 // link condition makes that region a disk whose boundary, the edge's link,
 // both fans share; positively turned triangles with that boundary cover
 // each point of it once). No point of the surface moves farther than
-// 2 kPlanar, so no face comes nearer to another than it was: the clash
-// query is not needed. kPlanar (delta / 1024) is well inside the factor 2
-// the clearance keeps spare (core/clearance.h). Most collapses of a CAD
+// 2 kPlanar, so no sample changes side or comes nearer to the surface, and
+// no face nearer to another, than it was: neither the samples' sweep nor
+// the clash query is needed. kPlanar (delta / 1024) is well inside the
+// factor 2 the clearance keeps spare (core/clearance.h). Most collapses of a CAD
 // part's flats are such (`press --faces` on bench/compare's CAD part at
 // 256^3: the stats' `in_plane`). The box of the new faces is still set
 // (the round's overlap test reads it).
