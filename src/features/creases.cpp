@@ -12,6 +12,7 @@
 #include "smooth/quadric.h"
 #include "smooth/stick_solid.h"
 #include "smooth/surface_graph.h"
+#include "feature_context.h"
 #include "voxpress/features/flats.h"
 #include "core/parallel.h"
 
@@ -272,11 +273,15 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
 }  // namespace detail
 
 size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o, std::vector<uint8_t>* zone) {
+  return detail::fit_creases(s, seg, o, zone, detail::Adjacency(s.stick_count(), s.triangles));
+}
+
+size_t detail::fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o, std::vector<uint8_t>* zone,
+                           const Adjacency& graph) {
   const size_t n = s.stick_count();
   if (zone) zone->assign(n, 0);
   if (seg.flats.empty() || !o.passes.on(Pass::crease_fit)) return 0;
-  std::vector<uint32_t> off, adj;
-  detail::vertex_adjacency(n, s.triangles, off, adj);
+  const std::vector<uint32_t>&off = graph.off, &adj = graph.adj;
   std::vector<Vec3> x(n);
   detail::parallel_for(n, [&](size_t v) { x[v] = s.index_position(v); });
   const detail::CreaseFit c{
@@ -291,10 +296,14 @@ size_t fit_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptio
 
 size_t fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o,
                           std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed) {
+  return detail::fit_curved_creases(s, seg, o, fixed, placed, detail::Adjacency(s.stick_count(), s.triangles));
+}
+
+size_t detail::fit_curved_creases(StickSurface& s, const FlatSegmentation& seg, const FlatOptions& o,
+                                  std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed, const Adjacency& graph) {
   const size_t n = s.stick_count();
   if (!o.passes.on(Pass::curved_creases) || seg.region.size() != n) return 0;
-  std::vector<uint32_t> off, adj;
-  detail::vertex_adjacency(n, s.triangles, off, adj);
+  const std::vector<uint32_t>&off = graph.off, &adj = graph.adj;
   std::vector<Vec3> x(n);
   detail::parallel_for(n, [&](size_t v) { x[v] = s.index_position(v); });
   fixed.resize(n, 0);

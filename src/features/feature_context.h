@@ -9,7 +9,9 @@
 
 #include <vector>
 
+#include "smooth/surface_graph.h"
 #include "voxpress/features/flats.h"
+#include "voxpress/features/sharpen.h"
 #include "voxpress/smooth/pressing.h"
 
 namespace voxpress::flats_impl {
@@ -27,6 +29,7 @@ struct CreaseRound {
   StickSurface& s;
   FlatSegmentation& seg;
   const FlatOptions& o;
+  const Adjacency& graph;
   std::vector<uint8_t> fixed;    // placed by crease_fit, then curved_creases
   std::vector<uint8_t> barrier;  // seg.barrier and the curved creases' vertices
   bool last = false;             // the last round: the one whose counts are reported
@@ -36,6 +39,7 @@ struct CreaseRound {
 struct FitStage {
   StickSurface& s;
   const FlatSegmentation& seg;
+  const Adjacency& graph;
   QuadricFitOptions o;
   QuadricFitStats out;
 };
@@ -53,5 +57,19 @@ struct FeatureContext {
 
 // Runs `stage`'s steps, in table order.
 void run_stage(Stage stage, FeatureContext& ctx);
+
+// The public stages on a surface whose adjacency is built once per run
+// (smooth/pipeline.cpp): find_flats, fit_creases, fit_curved_creases,
+// press_with_flats and sharpen, given that adjacency.
+FlatSegmentation find_flats(const StickSurface& surface, const SliceCurves& curves, const std::vector<double>& estimate,
+                            const FlatOptions& options, const Adjacency& graph);
+size_t fit_creases(StickSurface& surface, const FlatSegmentation& flats, const FlatOptions& options,
+                   std::vector<uint8_t>* placed, const Adjacency& graph);
+size_t fit_curved_creases(StickSurface& surface, const FlatSegmentation& flats, const FlatOptions& options,
+                          std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed, const Adjacency& graph);
+FeaturePressStats press_with_flats(StickSurface& surface, const SliceCurves& curves, const PressOptions& options,
+                                   const FlatOptions* flat_options, FlatSegmentation* flats, const Adjacency& graph);
+SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options,
+                      const Adjacency& graph);
 
 }  // namespace voxpress::detail

@@ -5,6 +5,7 @@
 #include "feature_context.h"
 #include "feature_tuning.h"
 #include "smooth/curve_kernel.h"
+#include "smooth/quadric.h"
 #include "voxpress/features/flats.h"
 
 #include <algorithm>
@@ -67,7 +68,7 @@ struct Segmented {
 };
 
 Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail::Layout& layout,
-                  const PressOptions& po, const FlatOptions& fo) {
+                  const PressOptions& po, const FlatOptions& fo, const detail::Adjacency& graph) {
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
@@ -81,7 +82,7 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
   FlatOptions early = fo;
   early.passes.disable(Pass::crease_refit);
   FlatSegmentation& seg = g.seg;
-  seg = find_flats(s, curves, g.est.t, detail::kDetectionPasses > 1 ? early : fo);
+  seg = detail::find_flats(s, curves, g.est.t, detail::kDetectionPasses > 1 ? early : fo, graph);
   // Beyond the paper: a second pass. The estimate of a face next to rounded
   // edges is a pillow whose normals spread past the acceptance test (64^3
   // boxes, thin plates). Pressed again with the first pass's flats frozen,
@@ -99,7 +100,7 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
     detail::press_on(g.est, layout, again, frozen_of(seg), seg.barrier);
     t_est += seconds_since(t1);
     const FlatStats before = seg.stats;
-    seg = find_flats(s, curves, g.est.t, pass + 1 < detail::kDetectionPasses ? early : fo);
+    seg = detail::find_flats(s, curves, g.est.t, pass + 1 < detail::kDetectionPasses ? early : fo, graph);
     seg.stats.seconds_detect += before.seconds_detect;
     seg.stats.seconds_junctions += before.seconds_junctions;
     // The seconds and trace of both detections, the last one's counts.
@@ -117,11 +118,17 @@ FlatSegmentation segment_flats(const StickSurface& s, const SliceCurves& curves,
                                const FlatOptions& fo) {
   detail::Layout layout;
   detail::make_layout(s, curves, layout);
-  return segment(s, curves, layout, po, fo).seg;
+  return segment(s, curves, layout, po, fo, detail::Adjacency(s.stick_count(), s.triangles)).seg;
 }
 
 FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
                                    const FlatOptions* fo, FlatSegmentation* out) {
+  return detail::press_with_flats(s, curves, po, fo, out,
+                                  fo ? detail::Adjacency(s.stick_count(), s.triangles) : detail::Adjacency());
+}
+
+FeaturePressStats detail::press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
+                                           const FlatOptions* fo, FlatSegmentation* out, const Adjacency& graph) {
   FeaturePressStats st;
   if (!fo) {
     st.press = press(s, curves, po);
@@ -133,7 +140,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   }
   detail::Layout layout;  // one for every press of the surface
   detail::make_layout(s, curves, layout);
-  Segmented g = segment(s, curves, layout, po, *fo);
+  Segmented g = segment(s, curves, layout, po, *fo, graph);
   FlatSegmentation& seg = g.seg;
   const PressStats& first_estimate = g.first;
   const StickSurface& est = g.est;
@@ -163,7 +170,7 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
   }
   for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
     const auto t2 = std::chrono::steady_clock::now();
-    detail::CreaseRound cr{s, seg, *fo, {}, seg.barrier, round + 1 == detail::kCreaseRounds};
+    detail::CreaseRound cr{s, seg, *fo, graph, {}, seg.barrier, round + 1 == detail::kCreaseRounds};
     cr.barrier.resize(s.stick_count(), 0);
     detail::FeatureContext fc{fo->passes, st.passes};
     fc.crease = &cr;
@@ -199,7 +206,7 @@ namespace detail {
 
 size_t crease_fit_step(FeatureContext& c) {
   CreaseRound& r = *c.crease;
-  r.seg.stats.crease_vertices = fit_creases(r.s, r.seg, r.o, &r.fixed);
+  r.seg.stats.crease_vertices = fit_creases(r.s, r.seg, r.o, &r.fixed, r.graph);
   return r.last ? r.seg.stats.crease_vertices : 0;
 }
 
@@ -207,13 +214,13 @@ size_t curved_creases_step(FeatureContext& c) {
   // The curved crease vertices cut the slice curves too (barriers), so
   // neither side's bilaplacian reaches across them.
   CreaseRound& r = *c.crease;
-  r.seg.stats.curved_crease_vertices = fit_curved_creases(r.s, r.seg, r.o, r.fixed, &r.barrier);
+  r.seg.stats.curved_crease_vertices = fit_curved_creases(r.s, r.seg, r.o, r.fixed, &r.barrier, r.graph);
   return r.last ? r.seg.stats.curved_crease_vertices : 0;
 }
 
 size_t quadric_fit_step(FeatureContext& c) {
   FitStage& f = *c.fit;
-  f.out = fit_local_quadrics(f.s, f.seg.region, f.seg.junction, f.o);
+  f.out = fit_local_quadrics(f.s, f.seg.region, f.seg.junction, f.o, nullptr, f.graph);
   return f.out.moved;
 }
 

@@ -98,12 +98,12 @@ bool Detector::accept(const std::vector<uint32_t>& core, const Plane& P) const {
 }
 
 FlatsContext::FlatsContext(const StickSurface& surface, const std::vector<double>& estimate, const FlatOptions& options,
-                           FlatSegmentation& out)
+                           FlatSegmentation& out, const detail::Adjacency& graph)
     : s(surface),
       o(options),
       seg(out),
       n(surface.stick_count()),
-      S(make_surface(surface, estimate)),
+      S(make_surface(surface, estimate, graph)),
       cone(detail::kFlatCone * kPi / 180),
       cos_cone(std::cos(cone)),
       M(surface.lattice.index_to_physical_matrix()),
@@ -463,6 +463,11 @@ size_t merge_step(FeatureContext& c) {
 
 FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, const std::vector<double>& estimate,
                             const FlatOptions& o) {
+  return detail::find_flats(s, curves, estimate, o, detail::Adjacency(s.stick_count(), s.triangles));
+}
+
+FlatSegmentation detail::find_flats(const StickSurface& s, const SliceCurves& curves, const std::vector<double>& estimate,
+                                    const FlatOptions& o, const Adjacency& graph) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = s.stick_count();
   if (estimate.size() != n) throw std::invalid_argument("find_flats: the estimate does not match the sticks");
@@ -472,7 +477,7 @@ FlatSegmentation find_flats(const StickSurface& s, const SliceCurves& curves, co
   seg.junction.assign(n, 0);
   seg.barrier.assign(n, 0);
   if (n == 0) return seg;
-  FlatsContext ctx(s, estimate, o, seg);
+  FlatsContext ctx(s, estimate, o, seg, graph);
   detail::FeatureContext fc{o.passes, seg.stats.passes};
   fc.detect = &ctx;
   detail::run_stage(Stage::detect, fc);

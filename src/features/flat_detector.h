@@ -365,7 +365,7 @@ struct Detector {
 // and the barriers in flat_junctions.cpp.
 struct FlatsContext {
   FlatsContext(const StickSurface& surface, const std::vector<double>& estimate, const FlatOptions& options,
-               FlatSegmentation& out);
+               FlatSegmentation& out, const detail::Adjacency& graph);
   const StickSurface& s;
   const FlatOptions& o;
   FlatSegmentation& seg;

@@ -360,9 +360,8 @@ Plane lerp(const Plane& a, const Plane& b, double l) {
 }
 
 
-Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
-  Surface S;
-  S.s = &s;
+Surface make_surface(const StickSurface& s, const std::vector<double>& t, const detail::Adjacency& graph) {
+  Surface S{&s, {}, {}, {}, graph.off, graph.adj};
   const size_t n = s.stick_count();
   S.x.resize(n);
   detail::parallel_for(n, [&](size_t v) {
@@ -383,7 +382,6 @@ Surface make_surface(const StickSurface& s, const std::vector<double>& t) {
     const double l = S.nrm[v].norm();
     S.nrm[v] = l > 0 ? Vec3(S.nrm[v] / l) : Vec3(0, 0, 1);
   });
-  detail::vertex_adjacency(n, s.triangles, S.adj_off, S.adj);
   // Per-vertex normals of the pressed surface still carry a few degrees of
   // staircase noise; averaging over a few rings brings them under one.
   std::vector<Vec3> next(n);

@@ -118,7 +118,8 @@ struct Surface {
   const StickSurface* s;
   std::vector<Vec3> x, nrm;         // estimated vertex positions and unit normals (index space)
   std::vector<double> area;         // a third of the incident triangle areas (index space)
-  std::vector<uint32_t> adj_off, adj;  // vertex adjacency (CSR)
+  const std::vector<uint32_t>& adj_off;  // vertex adjacency (CSR): the surface's, built once
+  const std::vector<uint32_t>& adj;
   // The estimated positions of vertices vs, into pts.
   void positions(const std::vector<uint32_t>& vs, std::vector<Vec3>& pts) const {
     pts.resize(vs.size());
@@ -185,7 +186,7 @@ bool constrained_fit(const Surface& S, const std::vector<uint32_t>& cluster, con
 Plane lerp(const Plane& a, const Plane& b, double l);
 
 // The estimate's surface data: positions, smoothed normals, areas, adjacency.
-Surface make_surface(const StickSurface& s, const std::vector<double>& t);
+Surface make_surface(const StickSurface& s, const std::vector<double>& t, const detail::Adjacency& graph);
 
 // The crease refit (crease_refit.cpp).
 bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg, std::vector<Plane>& planes,

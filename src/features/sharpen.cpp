@@ -9,7 +9,6 @@ namespace voxpress::sharpen_impl {
 
 SharpenResult Sharpener::run() {
   const auto t0 = std::chrono::steady_clock::now();
-  detail::vertex_adjacency(n, s.triangles, adj_off, adj);
   x.resize(n);
   for (size_t v = 0; v < n; ++v) x[v] = s.index_position(v);
   plane_state.assign(n, 0);
@@ -158,11 +157,16 @@ Vec3 solve_planes(const Plane* planes, int count, const Vec3& x0, double floor) 
 namespace voxpress {
 
 SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options) {
+  return detail::sharpen(surface, flats, options, detail::Adjacency(surface.stick_count(), surface.triangles));
+}
+
+SharpenResult detail::sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options,
+                              const Adjacency& graph) {
   if (!flats.region.empty() && flats.region.size() != surface.stick_count())
     throw std::invalid_argument("sharpen: segmentation does not match the surface");
   FlatSegmentation none;  // no segmentation: every vertex curved
   if (flats.region.empty()) none.region.assign(surface.stick_count(), -1);
-  sharpen_impl::Sharpener sh(surface, flats.region.empty() ? none : flats, options);
+  sharpen_impl::Sharpener sh(surface, flats.region.empty() ? none : flats, options, graph);
   return sh.run();
 }
 

@@ -86,7 +86,8 @@ struct Sharpener {
   const SharpenOptions& o;
   size_t n = 0;
   Mat3 Minv_t;
-  std::vector<uint32_t> adj_off, adj;       // original vertex adjacency
+  const std::vector<uint32_t>& adj_off;     // original vertex adjacency: the surface's, built once
+  const std::vector<uint32_t>& adj;
   std::vector<Vec3> x;                      // positions (index space): original, then new
   std::vector<Triangle> tris;               // the refined triangles
   std::vector<NewVertex> nv;                // new vertex n + k
@@ -113,8 +114,9 @@ struct Sharpener {
   const std::vector<uint8_t>*editable = nullptr, *fixed = nullptr;
   std::vector<uint32_t> parent;  // per refined triangle: the original triangle it came from
 
-  Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts)
-      : s(surface), seg(f), o(opts), n(surface.stick_count()) {
+  Sharpener(const StickSurface& surface, const FlatSegmentation& f, const SharpenOptions& opts,
+            const detail::Adjacency& graph)
+      : s(surface), seg(f), o(opts), n(surface.stick_count()), adj_off(graph.off), adj(graph.adj) {
     Minv_t = s.lattice.index_to_physical_matrix().inverse().transpose();
     delta = detail::float32_clearance(s.lattice, detail::kMaxMove + 1);
   }

@@ -59,7 +59,8 @@ LabelEdit sharpen_label(LabelView v, const FlatSegmentation& seg, const SharpenO
   e.idx = std::move(v.idx);
   const StickSurface& surf = v.surf;
   const size_t n = surf.stick_count();
-  sharpen_impl::Sharpener sh(surf, seg, o);
+  const detail::Adjacency graph(surf.stick_count(), surf.triangles);
+  sharpen_impl::Sharpener sh(surf, seg, o, graph);
   sh.editable = &v.editable;
   sh.fixed = &v.fixed;
   e.stats = sh.run().stats;

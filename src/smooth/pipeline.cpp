@@ -136,8 +136,9 @@ void require_float32_room(const Lattice& lattice, const SurfaceOptions& o, const
 
 namespace {
 
-// press_stick_surface's stages on sticks already on their own box.
-void press_on_own_box(StickSurface& surface, const SurfaceOptions& o, SurfaceResult& r) {
+// press_stick_surface's stages on sticks already on their own box, with
+// the surface's adjacency (built once for every stage of the run).
+void press_on_own_box(StickSurface& surface, const SurfaceOptions& o, SurfaceResult& r, const detail::Adjacency& graph) {
   const PassSet& on = o.passes;
   PressOptions po = o.press;
   FlatOptions fo = o.flat;
@@ -147,10 +148,10 @@ void press_on_own_box(StickSurface& surface, const SurfaceOptions& o, SurfaceRes
   o.overrides.apply(po);
   const bool features = on.on(Pass::flats);
   const SliceCurves curves = build_slice_curves(surface);
-  const FeaturePressStats fs = press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats);
+  const FeaturePressStats fs = detail::press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats, graph);
   r.press = fs.press;
   r.pass_times = fs.passes;
-  detail::FitStage fit{surface, r.flats, o.fit, {}};
+  detail::FitStage fit{surface, r.flats, graph, o.fit, {}};
   fit.o.margin = po.margin;
   detail::FeatureContext fc{on, r.pass_times};
   fc.fit = &fit;
@@ -166,7 +167,7 @@ void press_stick_surface(StickSurface& sticks, const SurfaceOptions& o, SurfaceR
   // sticks come back on their lattice (the chunked path's blocks too).
   OwnBox frame;
   StickSurface surface = on_own_box(std::move(sticks), &frame);
-  press_on_own_box(surface, o, r);
+  press_on_own_box(surface, o, r, detail::Adjacency(surface.stick_count(), surface.triangles));
   sticks = off_own_box(std::move(surface), frame);
 }
 
@@ -193,14 +194,15 @@ SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, Surfa
     case Method::pressing: {
       OwnBox frame;  // as press_stick_surface, the sharpening on the same box
       StickSurface own = on_own_box(std::move(surface), &frame);
-      press_on_own_box(own, o, r);
+      const detail::Adjacency graph(own.stick_count(), own.triangles);
+      press_on_own_box(own, o, r, graph);
       const PassSet& on = o.passes;
       const bool features = on.on(Pass::flats);
       if (features && on.on(Pass::sharpen)) {
         SharpenOptions so = o.sharp;
         so.colors = o.color_regions;
         so.passes = on;
-        SharpenResult sr = sharpen(std::move(own), r.flats, so);
+        SharpenResult sr = detail::sharpen(own, r.flats, so, graph);
         r.mesh = std::move(sr.mesh);
         r.sharpen = sr.stats;
         r.pass_times.add(sr.stats.passes);

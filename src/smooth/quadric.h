@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "surface_graph.h"
+#include "voxpress/smooth/pressing.h"
 
 namespace voxpress::detail {
 
@@ -121,5 +122,11 @@ struct Quadric {
     return best;
   }
 };
+
+// fit_local_quadrics on a surface whose adjacency is built once per run
+// (smooth/pipeline.cpp); `graph` is read only when there is work.
+QuadricFitStats fit_local_quadrics(StickSurface& surface, const std::vector<int32_t>& region,
+                                   const std::vector<uint8_t>& junction, const QuadricFitOptions& options,
+                                   const std::vector<uint8_t>* only, const Adjacency& graph);
 
 }  // namespace voxpress::detail

@@ -199,6 +199,13 @@ struct FitScratch {
 QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& region,
                                    const std::vector<uint8_t>& junction, const QuadricFitOptions& o,
                                    const std::vector<uint8_t>* only) {
+  if (o.rings <= 0 || s.stick_count() == 0) return detail::fit_local_quadrics(s, region, junction, o, only, {});
+  return detail::fit_local_quadrics(s, region, junction, o, only, detail::Adjacency(s.stick_count(), s.triangles));
+}
+
+QuadricFitStats detail::fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& region,
+                                           const std::vector<uint8_t>& junction, const QuadricFitOptions& o,
+                                           const std::vector<uint8_t>* only, const Adjacency& graph) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = s.stick_count();
   if (!region.empty() && region.size() != n) throw std::invalid_argument("fit_local_quadrics: regions do not match the sticks");
@@ -208,8 +215,7 @@ QuadricFitStats fit_local_quadrics(StickSurface& s, const std::vector<int32_t>& 
   QuadricFitStats st;
   if (o.rings <= 0 || n == 0) return st;
   const auto fresh = [&](size_t v) { return (region.empty() || region[v] < 0) && (junction.empty() || !junction[v]); };
-  std::vector<uint32_t> off, adj;
-  detail::vertex_adjacency(n, s.triangles, off, adj);
+  const std::vector<uint32_t>&off = graph.off, &adj = graph.adj;
   // Per vertex, once (every fit reads ~90 neighbours): its position and its
   // stick's inside and outside samples (lattice points: exact in float).
   std::vector<Vec3> x(n);

@@ -185,6 +185,15 @@ inline void vertex_adjacency(size_t n, const std::vector<Triangle>& triangles, s
   adj.resize(out);
 }
 
+// A surface's vertex adjacency (CSR, as vertex_adjacency), built once per
+// surface and shared by every stage that walks its rings (the triangles do
+// not change while the feature layer runs).
+struct Adjacency {
+  std::vector<uint32_t> off, adj;
+  Adjacency() = default;
+  Adjacency(size_t n, const std::vector<Triangle>& triangles) { vertex_adjacency(n, triangles, off, adj); }
+};
+
 // Gauss-Seidel umbrella relaxation (Bade Section 4; Gibson's nets): each
 // iteration visits the vertices in order and sets x[v] = project(v, mean of
 // its neighbours' current positions); stops once no vertex moved more than
