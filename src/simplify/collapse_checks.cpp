@@ -127,6 +127,7 @@ Collapser::Verdict Collapser::check(const Move& m, Probe& p) const {
 // 256^3: the stats' `in_plane`). The box of the new faces is still set
 // (the round's overlap test reads it).
 bool Collapser::in_plane(const Move& m, const Vec3& qi, Probe& p) const {
+  if (o.junctions) return false;  // a shared surface: which label lies behind each part of the plane could change
   const double eps = delta / 1024;
   Vec3 n = Vec3::Zero(), a = Vec3::Zero();
   for (uint32_t f : p.ring) {
@@ -281,9 +282,12 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi, Probe& p) const {
   // tetrahedron once, with the sign of its orientation, so the sum over the
   // two moves' tetrahedra of the signed memberships is the change of the
   // sample's winding number (a sample swept forwards and back keeps its
-  // side). A sample on a tetrahedron's boundary, or near a flat sweep,
-  // counts as changed (conservative).
-  std::vector<std::pair<uint64_t, int>>& hits = p.hits;
+  // side). On a shared surface the sum is taken per label pair (face
+  // class): a sweep by an (a, b) face undone by a (b, c) face moves the
+  // sample from label a to c (the 61-label map lost 1-2 samples per run to
+  // that before). A sample on a tetrahedron's boundary, or near a flat
+  // sweep, counts as changed (conservative).
+  std::vector<std::tuple<uint64_t, uint32_t, int>>& hits = p.hits;
   hits.clear();
   const auto key = [&](const Vec3& z) {
     const Vec3 k = z - key_base;
@@ -309,7 +313,7 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi, Probe& p) const {
         changed = any({a, qi, c, d}, [&](const Vec3& z) {
           const int in = in_tetrahedron(a, qi, c, d, z, sense);
           if (in == 2) return true;
-          if (in != 0) hits.emplace_back(key(z), in);
+          if (in != 0) hits.emplace_back(key(z), face_class.empty() ? 0 : face_class[f], in);
           return false;
         });
       }
@@ -317,9 +321,10 @@ bool Collapser::samples_ok(const Move& m, const Vec3& qi, Probe& p) const {
     }
   }
   std::sort(hits.begin(), hits.end());
+  const auto same = [](const auto& x, const auto& y) { return std::get<0>(x) == std::get<0>(y) && std::get<1>(x) == std::get<1>(y); };
   for (size_t i = 0, j = 0; i < hits.size(); i = j) {
     int net = 0;
-    for (j = i; j < hits.size() && hits[j].first == hits[i].first; ++j) net += hits[j].second;
+    for (j = i; j < hits.size() && same(hits[j], hits[i]); ++j) net += std::get<2>(hits[j]);
     if (net != 0) return false;
   }
   for (uint32_t f : p.ring) {

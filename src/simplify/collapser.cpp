@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <queue>
@@ -149,6 +150,15 @@ void Collapser::build() {
     if (hard) feature[he[i].key] |= kBorder;
   }
   he = {};
+  if (o.junctions) {  // the face classes: one per distinct tuple of face attributes
+    std::map<std::vector<double>, uint32_t> classes;
+    std::vector<double> tuple(mesh.face_attributes.size());
+    face_class.resize(nf);
+    for (uint32_t f = 0; f < nf; ++f) {
+      for (size_t k = 0; k < tuple.size(); ++k) tuple[k] = mesh.face_attributes[k].values[f];
+      face_class[f] = classes.try_emplace(tuple, uint32_t(classes.size())).first->second;
+    }
+  }
   for (const auto& e : mesh.edges) {
     const auto it = std::lower_bound(edges.begin(), edges.end(), key(e[0], e[1]));
     if (it != edges.end() && *it == key(e[0], e[1])) feature[*it] |= kSharp;

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <queue>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -63,7 +64,7 @@ class Collapser {
   struct Probe {
     std::vector<uint32_t> ring, shared, nu, nv, common;
     std::vector<std::pair<uint32_t, uint32_t>> assign;  // (input vertex, face)
-    std::vector<std::pair<uint64_t, int>> hits;  // samples_ok's swept samples: (sample key, sign)
+    std::vector<std::tuple<uint64_t, uint32_t, int>> hits;  // samples_ok's swept samples: (sample key, face class, sign)
     Vec3 lo, hi;
     bool planar = false;  // the last check proved the move inside one plane (in_plane)
     bool is_shared(uint32_t f) const { return std::find(shared.begin(), shared.end(), f) != shared.end(); }
@@ -119,6 +120,10 @@ class Collapser {
   std::unordered_map<uint64_t, uint8_t> feature;  // edge key -> kSharp | kBorder
   std::vector<uint8_t> fdeg;                       // feature edges at each vertex (capped at 255)
   std::vector<std::vector<uint32_t>> attached;     // per face: removed input vertices nearest to it
+  // With junctions (a shared surface): per face, the class of its face
+  // attributes (one per label pair); empty otherwise. A face's attributes
+  // never change, so neither does its class.
+  std::vector<uint32_t> face_class;
   FaceGrid grid;
   uint64_t grid_faces = 0;  // alive faces when the grid was last built
   double delta = 0;                                // index-space clearance
