@@ -486,6 +486,7 @@ FlatSegmentation detail::find_flats(const StickSurface& s, const SliceCurves& cu
   mark_barriers(ctx, curves);
   seg.stats.passes.count[size_t(Pass::tangent_borders)] = ctx.smooth_borders;
   seg.stats.passes.count[size_t(Pass::ring_off_plane)] = ctx.off_plane_junctions;
+  seg.stats.passes.count[size_t(Pass::round_borders)] = ctx.round_borders;
   const PassTimes& p = seg.stats.passes;
   seg.stats.seconds_detect = p.seconds[size_t(Pass::flats)] + p.seconds[size_t(Pass::merge)];
   seg.stats.seconds_junctions = seconds_since(t0) - seg.stats.seconds_detect;

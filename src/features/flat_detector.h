@@ -380,6 +380,7 @@ struct FlatsContext {
   // The last detection's smooth borders (tangent-borders) and junction
   // planes of the off-plane points (ring-off-plane).
   std::atomic<size_t> smooth_borders{0}, off_plane_junctions{0};
+  size_t round_borders = 0;  // the last detection's junction vertices released by round-borders
 
   Flat flat_of(const Plane& P) const;
   // Physical height of index point x over flat F's plane, from its index

@@ -193,3 +193,32 @@ bool crease_refit(const Surface& S, const FlatOptions& o, FlatSegmentation& seg,
                   std::vector<uint8_t>& moved);
 
 }  // namespace voxpress::flats_impl
+
+namespace voxpress::detail {
+
+// A point at depths u, v >= 0 inside two half-spaces whose outward normals
+// have cosine c: is it cut off by the fillet of radius r tangent to both
+// planes (between its arc and the planes' edge)? In the cross-section the
+// point minus the fillet's centre is w = alpha n_a + beta n_b (n . w = r -
+// depth); it is cut when w points into the arc's sector (alpha, beta >= 0)
+// beyond the arc.
+inline bool cut_by_fillet(double u, double v, double c, double r) {
+  const double du = r - u, dv = r - v, g = 1 - c * c;
+  const double alpha = (du - c * dv) / g, beta = (dv - c * du) / g;
+  return alpha >= 0 && beta >= 0 && (du * du + dv * dv - 2 * c * du * dv) / g > r * r;
+}
+
+// The smallest fillet radius that cuts the point off (the fillets' solids
+// nest, so bisection); `cap` when none up to it does or when the point is
+// outside a half-space (no fillet reaches it).
+inline double cutting_radius(double u, double v, double c, double cap) {
+  if (u < 0 || v < 0 || !cut_by_fillet(u, v, c, cap)) return cap;
+  double lo = 0, hi = cap;
+  for (int it = 0; it < 30; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (cut_by_fillet(u, v, c, mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+
+}  // namespace voxpress::detail

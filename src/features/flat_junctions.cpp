@@ -145,6 +145,78 @@ bool is_junction(FlatsContext& ctx, size_t v, int32_t f0, detail::RingScratch& r
   return sharp;
 }
 
+// Beyond the paper (round-borders, issue 75): a border the lattice
+// resolves as a fillet is no crease. Junction vertices are grouped into
+// chains (connected junctions between the same two flats: v's first flat
+// and the flat nearest v within kRoundBorderRings rings). A chain's samples
+// bound how round the edge of the two planes may be (cutting_radius, as
+// round-chains judges the sharpening's chains: at a convex edge no inside
+// sample of the chain's sticks and their 1-rings may lie outside the
+// fillet, at a concave one no outside sample), and must demand a rounding
+// (a sample of the other kind kRoundEvidence inside both planes). A chain
+// allowing kRoundBorderRadius or more is a resolved fillet: its vertices
+// are no junctions, so the extension does not freeze the fillet's start
+// onto a flat's plane (at r = 2-3 cells that flattening was most of the
+// error with and without sharpening). Returns the vertices released.
+size_t round_borders(FlatsContext& ctx) {
+  const Surface& S = ctx.S;
+  FlatSegmentation& seg = ctx.seg;
+  const size_t n = ctx.n;
+  std::vector<std::array<int32_t, 2>> pair(n, {-1, -1});
+  detail::parallel_ranges(n, 256, [&](detail::IndexRange r) {
+    detail::RingScratch& rs = ctx.scratch.local();
+    for (size_t v = r.begin(); v < r.end(); ++v) {
+      if (!seg.junction[v]) continue;
+      const int32_t f0 = first_flat(ctx, v);
+      if (f0 < 0) continue;
+      detail::rings_around(uint32_t(v), uint32_t(detail::kRoundBorderRings), S.adj_off, S.adj, [](uint32_t) { return true; }, rs);
+      int32_t g = -1;
+      uint32_t best = UINT32_MAX;
+      for (const auto& [w, d] : rs.out)
+        if (const int32_t f = seg.region[w]; f >= 0 && f != f0 && (d < best || (d == best && f < g))) g = f, best = d;
+      if (g >= 0) pair[v] = {std::min(f0, g), std::max(f0, g)};
+    }
+  });
+  constexpr double kCap = 16;  // cells: no sample bounds the rounding (round-chains' cap)
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<uint32_t> chain;
+  size_t released = 0;
+  for (uint32_t v0 = 0; v0 < n; ++v0) {
+    if (!seg.junction[v0] || seen[v0] || pair[v0][0] < 0) continue;
+    chain.assign(1, v0);
+    seen[v0] = 1;
+    for (size_t k = 0; k < chain.size(); ++k)
+      for (uint32_t q = S.adj_off[chain[k]]; q < S.adj_off[chain[k] + 1]; ++q)
+        if (const uint32_t w = S.adj[q]; seg.junction[w] && !seen[w] && pair[w] == pair[v0]) seen[w] = 1, chain.push_back(w);
+    const Flat& A = seg.flats[size_t(pair[v0][0])];
+    const Flat& B = seg.flats[size_t(pair[v0][1])];
+    const auto ha = [&](const Vec3& x) { return A.index_normal.dot(x) - A.index_offset; };
+    const auto hb = [&](const Vec3& x) { return B.index_normal.dot(x) - B.index_offset; };
+    const double c = A.index_normal.dot(B.index_normal);
+    int convex = 0, concave = 0;
+    for (uint32_t v : chain) {
+      convex += ha(S.x[v]) < 0 && hb(S.x[v]) < 0;
+      concave += ha(S.x[v]) > 0 && hb(S.x[v]) > 0;
+    }
+    // Convex or concave by 3 to 1 (as crease_kind_near); parallel planes have no edge.
+    const int kind = convex >= 3 * std::max(concave, 1) ? 1 : concave >= 3 * std::max(convex, 1) ? -1 : 0;
+    if (kind == 0 || std::abs(c) > 0.999) continue;
+    double allow = kCap;
+    bool demanded = false;
+    for (uint32_t v : chain)
+      for (uint32_t q = S.adj_off[v]; q <= S.adj_off[v + 1]; ++q) {  // v's 1-ring, then v
+        const uint32_t w = q == S.adj_off[v + 1] ? v : S.adj[q];
+        const Vec3 keep = kind > 0 ? S.inside(w) : S.outside(w), gone = kind > 0 ? S.outside(w) : S.inside(w);
+        allow = std::min(allow, detail::cutting_radius(-kind * ha(keep), -kind * hb(keep), c, kCap));
+        demanded |= std::min(-kind * ha(gone), -kind * hb(gone)) > detail::kRoundEvidence;
+      }
+    if (!demanded || allow < detail::kRoundBorderRadius || allow == kCap) continue;
+    for (uint32_t v : chain) seg.junction[v] = 0;
+    released += chain.size();
+  }
+  return released;
+}
+
 // ---- Junctions (Section 3): fresh vertices next to a frozen one whose
 // fresh 2-ring plane leans more than junction_angle from the flat. Resets
 // and recounts ctx's smooth borders and off-plane junctions.
@@ -163,6 +235,7 @@ void detect_junctions(FlatsContext& ctx) {
       seg.junction[v] = is_junction(ctx, v, f0, rs, pts);
     }
   });
+  if (ctx.o.passes.on(Pass::round_borders)) ctx.round_borders = round_borders(ctx);
 }
 
 }  // namespace

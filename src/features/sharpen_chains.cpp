@@ -30,35 +30,12 @@
 #include "sharpener.h"
 
 #include "feature_context.h"
+#include "flat_geometry.h"
 
 namespace voxpress::sharpen_impl {
 
 namespace {
 
-// A point at depths u, v >= 0 inside two half-spaces whose outward normals
-// have cosine c: is it cut off by the fillet of radius r tangent to both
-// planes (between its arc and the planes' edge)? In the cross-section the
-// point minus the fillet's centre is w = alpha n_a + beta n_b (n . w = r -
-// depth); it is cut when w points into the arc's sector (alpha, beta >= 0)
-// beyond the arc.
-bool cut_by_fillet(double u, double v, double c, double r) {
-  const double du = r - u, dv = r - v, g = 1 - c * c;
-  const double alpha = (du - c * dv) / g, beta = (dv - c * du) / g;
-  return alpha >= 0 && beta >= 0 && (du * du + dv * dv - 2 * c * du * dv) / g > r * r;
-}
-
-// The smallest fillet radius that cuts the point off (the fillets' solids
-// nest, so bisection); `cap` when none up to it does or when the point is
-// outside a half-space (no fillet reaches it).
-double cutting_radius(double u, double v, double c, double cap) {
-  if (u < 0 || v < 0 || !cut_by_fillet(u, v, c, cap)) return cap;
-  double lo = 0, hi = cap;
-  for (int it = 0; it < 30; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (cut_by_fillet(u, v, c, mid) ? hi : lo) = mid;
-  }
-  return hi;
-}
 
 }  // namespace
 
@@ -97,7 +74,7 @@ void Sharpener::judge_chains() {
       }
       for (uint32_t q : near) {
         const Vec3 keep = kind > 0 ? s.inside_sample(q) : s.outside_sample(q);
-        const double r = cutting_radius(-kind * (pa->n.dot(keep) - pa->c), -kind * (pb->n.dot(keep) - pb->c), c, cap);
+        const double r = detail::cutting_radius(-kind * (pa->n.dot(keep) - pa->c), -kind * (pb->n.dot(keep) - pb->c), c, cap);
         allow = std::min(allow, r);
         const Vec3 gone = kind > 0 ? s.outside_sample(q) : s.inside_sample(q);
         const double da = pa->n.dot(gone) - pa->c, db = pb->n.dot(gone) - pb->c;

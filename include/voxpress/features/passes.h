@@ -37,6 +37,7 @@ enum class Pass : uint8_t {
   curved_test,           // rule: a flat whose neighbourhood a quadric explains better is refused
   merge,                 // beyond: adjacent flats one plane stabs become one
   junctions,             // flats extended to their sharp edges; junction points
+  round_borders,         // rule: a junction chain whose samples allow a resolved fillet is a smooth border
   tangent_borders,       // rule: a would-be junction whose curved side continues the flat is a smooth border
   ring_off_plane,        // rule: the junction test's 2-ring plane leaves out a rim stopped short
   crease_refit,          // rule: planes also keep their creases' samples on their side
