@@ -161,6 +161,21 @@ struct CliRun {
 /// limit (RLIMIT_AS, bytes; 0 = none), so that a regression fails the test
 /// instead of exhausting the machine.
 CliRun run_cli_measured(const std::string& args, uint64_t address_space_limit = 0);
+/// Issue 75's family: the box at `res`, rotation random:seed, its edges and
+/// corners rounded by `fillet` cells (0: sharp), with its exact truth.
+struct FilletedBox {
+  GeneratedShape shape;
+  std::unique_ptr<Truth> truth;
+};
+inline FilletedBox filleted_box(int64_t res, int seed, double fillet) {
+  GenerateOptions o;
+  o.res = res;
+  o.rotation = parse_rotation("random:" + std::to_string(seed));
+  o.fillet = fillet;
+  FilletedBox b{generate_shape(ShapeKind::box, o), nullptr};
+  b.truth = shape_truth(ShapeKind::box, b.shape.linear, b.shape.translation, b.shape.fillet);
+  return b;
+}
 /// Lines in a command's output (one error = one line).
 inline size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 

@@ -292,13 +292,10 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
 TEST(Flats, FilletsTheLatticeResolvesAreNotFlattened) {
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    GenerateOptions o;
-    o.res = 64;
-    o.rotation = parse_rotation("random:" + std::to_string(seed));
     for (double r : {0.0, 2.5}) {
-      o.fillet = r;
-      const GeneratedShape g = generate_shape(ShapeKind::box, o);
-      const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation, g.fillet);
+      const test::FilletedBox box = test::filleted_box(64, seed, r);
+      const GeneratedShape& g = box.shape;
+      const auto& truth = box.truth;
       SurfaceOptions off;
       off.passes.disable(Pass::round_borders);
       const SurfaceResult a = smooth_surface(g.volume), b = smooth_surface(g.volume, off);

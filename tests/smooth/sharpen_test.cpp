@@ -441,14 +441,11 @@ TEST(Sharpen, FilletsTheLatticeResolvesStayRound) {
   // sharp box (r = 0) at the same rotations keeps all its edges.
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    GenerateOptions o;
-    o.res = 48;
-    o.rotation = parse_rotation("random:" + std::to_string(seed));
     size_t sharp_labels = 0;
     for (double r : {0.0, 1.5}) {
-      o.fillet = r;
-      const GeneratedShape g = generate_shape(ShapeKind::box, o);
-      const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation, g.fillet);
+      const test::FilletedBox box = test::filleted_box(48, seed, r);
+      const GeneratedShape& g = box.shape;
+      const auto& truth = box.truth;
       SurfaceOptions plain;
       plain.passes.disable(Pass::sharpen);
       const SurfaceResult on = smooth_surface(g.volume, {}), off = smooth_surface(g.volume, plain);
