@@ -23,7 +23,7 @@ constexpr int kDetectionPasses = 2;      // the second re-estimates with the fir
 constexpr double kTangentResidual = 0.1;       // cells RMS: a curved side fitting a quadric this well may be tangent (tangent-borders)
 constexpr double kJunctionRingOffPlane = 0.1;  // cells: fresh vertices this close to the flat's plane leave the 2-ring plane (ring-off-plane)
 // round-borders (flat_junctions.cpp): a junction chain between two flats is a resolved fillet when its samples
-constexpr double kRoundBorderRadius = 1.8;  // cells: ... allow this rounding (a sharp edge along a lattice axis allows up to ~sqrt 3, round-chains' note; 1.5 took CAD creases: bench_compare --quick cad-part 128 +7 %)
+constexpr double kRoundBorderRadius = 1.8;  // cells: ... allow this rounding (a sharp edge along a lattice axis allows up to ~sqrt 3, round-chains' note; build/bench/bench_fillets)
 constexpr int kRoundBorderRings = 3;        // rings searched for the chain's second flat (6 paired flats across narrow faces: bench_compare --quick cad-part 128 +8 %)
 // --- crease fit (press time)
 constexpr int kCreaseRings = 2;            // rings from a junction whose curved vertices are placed (the chamfer's width)
