@@ -221,4 +221,26 @@ inline double cutting_radius(double u, double v, double c, double cap) {
   return hi;
 }
 
+// What a crease's samples say of its rounding, gathered stick by stick
+// (round-chains over a sharpening chain, round-borders over a junction
+// chain). Between planes a and b meeting at a convex crease (kind 1) the
+// inside samples lie in the true solid, so the smallest fillet radius that
+// cuts one off bounds the rounding (`allow`, kRoundCap when none does); an
+// outside sample more than kRoundEvidence inside both planes, where only a
+// rounded edge puts it, demands one. At a concave crease (kind -1) the two
+// samples swap parts.
+constexpr double kRoundCap = 16;  // cells: no sample bounds the rounding at all (leaning planes, not a fillet)
+struct RoundingEvidence {
+  double allow = kRoundCap;
+  bool demanded = false;
+  void add(const Plane& a, const Plane& b, int kind, const Vec3& inside, const Vec3& outside) {
+    const Vec3& keep = kind > 0 ? inside : outside;
+    const Vec3& gone = kind > 0 ? outside : inside;
+    allow = std::min(allow, cutting_radius(-kind * (a.n.dot(keep) - a.c), -kind * (b.n.dot(keep) - b.c), a.n.dot(b.n), kRoundCap));
+    demanded |= std::min(-kind * (a.n.dot(gone) - a.c), -kind * (b.n.dot(gone) - b.c)) > kRoundEvidence;
+  }
+  // Round: the samples allow at least `radius` and demand a rounding, and some sample bounds it.
+  bool round(double radius) const { return demanded && allow >= radius && allow < kRoundCap; }
+};
+
 }  // namespace voxpress::detail

@@ -177,7 +177,6 @@ size_t round_borders(FlatsContext& ctx) {
       if (g >= 0) pair[v] = {std::min(f0, g), std::max(f0, g)};
     }
   });
-  constexpr double kCap = 16;  // cells: no sample bounds the rounding (round-chains' cap)
   std::vector<uint8_t> seen(n, 0);
   std::vector<uint32_t> chain;
   size_t released = 0;
@@ -188,29 +187,25 @@ size_t round_borders(FlatsContext& ctx) {
     for (size_t k = 0; k < chain.size(); ++k)
       for (uint32_t q = S.adj_off[chain[k]]; q < S.adj_off[chain[k] + 1]; ++q)
         if (const uint32_t w = S.adj[q]; seg.junction[w] && !seen[w] && pair[w] == pair[v0]) seen[w] = 1, chain.push_back(w);
-    const Flat& A = seg.flats[size_t(pair[v0][0])];
-    const Flat& B = seg.flats[size_t(pair[v0][1])];
-    const auto ha = [&](const Vec3& x) { return A.index_normal.dot(x) - A.index_offset; };
-    const auto hb = [&](const Vec3& x) { return B.index_normal.dot(x) - B.index_offset; };
-    const double c = A.index_normal.dot(B.index_normal);
+    const Flat& FA = seg.flats[size_t(pair[v0][0])];
+    const Flat& FB = seg.flats[size_t(pair[v0][1])];
+    const Plane A{FA.index_normal, FA.index_offset}, B{FB.index_normal, FB.index_offset};
     int convex = 0, concave = 0;
     for (uint32_t v : chain) {
-      convex += ha(S.x[v]) < 0 && hb(S.x[v]) < 0;
-      concave += ha(S.x[v]) > 0 && hb(S.x[v]) > 0;
+      const double ha = A.n.dot(S.x[v]) - A.c, hb = B.n.dot(S.x[v]) - B.c;
+      convex += ha < 0 && hb < 0;
+      concave += ha > 0 && hb > 0;
     }
     // Convex or concave by 3 to 1 (as crease_kind_near); parallel planes have no edge.
     const int kind = convex >= 3 * std::max(concave, 1) ? 1 : concave >= 3 * std::max(convex, 1) ? -1 : 0;
-    if (kind == 0 || std::abs(c) > 0.999) continue;
-    double allow = kCap;
-    bool demanded = false;
+    if (kind == 0 || std::abs(A.n.dot(B.n)) > 0.999) continue;
+    detail::RoundingEvidence evidence;
     for (uint32_t v : chain)
       for (uint32_t q = S.adj_off[v]; q <= S.adj_off[v + 1]; ++q) {  // v's 1-ring, then v
         const uint32_t w = q == S.adj_off[v + 1] ? v : S.adj[q];
-        const Vec3 keep = kind > 0 ? S.inside(w) : S.outside(w), gone = kind > 0 ? S.outside(w) : S.inside(w);
-        allow = std::min(allow, detail::cutting_radius(-kind * ha(keep), -kind * hb(keep), c, kCap));
-        demanded |= std::min(-kind * ha(gone), -kind * hb(gone)) > detail::kRoundEvidence;
+        evidence.add(A, B, kind, S.inside(w), S.outside(w));
       }
-    if (!demanded || allow < detail::kRoundBorderRadius || allow == kCap) continue;
+    if (!evidence.round(detail::kRoundBorderRadius)) continue;
     for (uint32_t v : chain) seg.junction[v] = 0;
     released += chain.size();
   }

@@ -34,11 +34,6 @@
 
 namespace voxpress::sharpen_impl {
 
-namespace {
-
-
-}  // namespace
-
 void Sharpener::judge_chains() {
   const size_t m = nv.size();
   std::vector<uint8_t> rejected(m, 0);
@@ -54,9 +49,7 @@ void Sharpener::judge_chains() {
         if (!nv[j].corner && chain[j] == kNone) chain[j] = i0, members.push_back(j);
       }
     }
-    const double cap = 16;  // cells: no sample bounds the rounding at all (leaning planes, not a fillet)
-    double allow = cap;
-    bool demanded = false;
+    detail::RoundingEvidence evidence;
     for (uint32_t i : members) {
       const NewVertex& v = nv[i];
       const Plane* pa = plane_of(v.a);
@@ -65,23 +58,15 @@ void Sharpener::judge_chains() {
       const double sa = pa->n.dot(x[v.b]) - pa->c, sb = pb->n.dot(x[v.a]) - pb->c;
       const int kind = sa < 0 && sb < 0 ? 1 : sa > 0 && sb > 0 ? -1 : 0;  // convex, concave, undecided
       if (kind == 0) continue;
-      const double c = pa->n.dot(pb->n);
       near.clear();
       for (uint32_t e : {v.a, v.b}) {
         near.push_back(e);
         for (uint32_t k = adj_off[e]; k < adj_off[e + 1]; ++k)
           if (label[adj[k]] == label[v.a] || label[adj[k]] == label[v.b]) near.push_back(adj[k]);
       }
-      for (uint32_t q : near) {
-        const Vec3 keep = kind > 0 ? s.inside_sample(q) : s.outside_sample(q);
-        const double r = detail::cutting_radius(-kind * (pa->n.dot(keep) - pa->c), -kind * (pb->n.dot(keep) - pb->c), c, cap);
-        allow = std::min(allow, r);
-        const Vec3 gone = kind > 0 ? s.outside_sample(q) : s.inside_sample(q);
-        const double da = pa->n.dot(gone) - pa->c, db = pb->n.dot(gone) - pb->c;
-        demanded |= (kind > 0 ? std::min(-da, -db) : std::min(da, db)) > detail::kRoundEvidence;
-      }
+      for (uint32_t q : near) evidence.add(*pa, *pb, kind, s.inside_sample(q), s.outside_sample(q));
     }
-    if (!demanded || allow < detail::kRoundRadius || allow == cap) continue;
+    if (!evidence.round(detail::kRoundRadius)) continue;
     ++st.round_chains;
     for (uint32_t i : members) nv[i].moves = nv[i].sharp = false, rejected[i] = 1;
   }
