@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -241,6 +242,25 @@ struct RoundingEvidence {
   }
   // Round: the samples allow at least `radius` and demand a rounding, and some sample bounds it.
   bool round(double radius) const { return demanded && allow >= radius && allow < kRoundCap; }
+  // Sharp: some sample forbids a rounding of `radius` (whether or not one is demanded).
+  bool forbids(double radius) const { return allow < radius; }
 };
+
+// The kind of the edge of planes a and b that points pos(v) for v in `vs`
+// lie along: convex (1) when they lie inside both planes 3 to 1 against
+// outside both, concave (-1) the other way, else 0; parallel planes have
+// no edge (0).
+template <class Pos>
+int edge_kind(const Plane& a, const Plane& b, const std::vector<uint32_t>& vs, Pos pos) {
+  if (std::abs(a.n.dot(b.n)) > 0.999) return 0;
+  int convex = 0, concave = 0;
+  for (uint32_t v : vs) {
+    const Vec3 p = pos(v);
+    const double ha = a.n.dot(p) - a.c, hb = b.n.dot(p) - b.c;
+    convex += ha < 0 && hb < 0;
+    concave += ha > 0 && hb > 0;
+  }
+  return convex >= 3 * std::max(concave, 1) ? 1 : concave >= 3 * std::max(convex, 1) ? -1 : 0;
+}
 
 }  // namespace voxpress::detail

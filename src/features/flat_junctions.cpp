@@ -190,15 +190,8 @@ size_t round_borders(FlatsContext& ctx) {
     const Flat& FA = seg.flats[size_t(pair[v0][0])];
     const Flat& FB = seg.flats[size_t(pair[v0][1])];
     const Plane A{FA.index_normal, FA.index_offset}, B{FB.index_normal, FB.index_offset};
-    int convex = 0, concave = 0;
-    for (uint32_t v : chain) {
-      const double ha = A.n.dot(S.x[v]) - A.c, hb = B.n.dot(S.x[v]) - B.c;
-      convex += ha < 0 && hb < 0;
-      concave += ha > 0 && hb > 0;
-    }
-    // Convex or concave by 3 to 1 (as crease_kind_near); parallel planes have no edge.
-    const int kind = convex >= 3 * std::max(concave, 1) ? 1 : concave >= 3 * std::max(convex, 1) ? -1 : 0;
-    if (kind == 0 || std::abs(A.n.dot(B.n)) > 0.999) continue;
+    const int kind = detail::edge_kind(A, B, chain, [&](uint32_t v) { return S.x[v]; });
+    if (kind == 0) continue;
     detail::RoundingEvidence evidence;
     for (uint32_t v : chain)
       for (uint32_t q = S.adj_off[v]; q <= S.adj_off[v + 1]; ++q) {  // v's 1-ring, then v

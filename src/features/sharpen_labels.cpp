@@ -3,6 +3,7 @@
 #include "sharpener.h"
 
 #include "feature_context.h"
+#include "flat_geometry.h"
 #include "core/parallel.h"
 
 namespace voxpress::sharpen_impl {
@@ -100,6 +101,79 @@ void Sharpener::thin_strips(std::vector<uint8_t>& mark) {
     }
 }
 
+// A strip (kStrip vertices, with the pockets kRimStrip beside them: one
+// component over both) is a narrow curved band between two flats: a crease
+// the flats stopped short of, or a fillet the lattice resolves. Joined
+// vertex by vertex, a fillet's band was flattened onto its planes (the
+// filleted boxes at r = 2-3 cells lost 4-8 % RMS to `--no-sharpen`), and
+// judged vertex by vertex (each stick the flats' solid explains) a band
+// came out half joined, worse than either. So the whole band decides,
+// with round-borders' evidence (RoundingEvidence) on its two flats (the
+// pair meeting at kMinAngle or more that most of its vertices' neighbours
+// belong to): a band whose samples forbid a rounding of
+// kRoundBorderRadius is a crease and joins; one that allows it and whose
+// sticks the flats' solid (solid_crossing) explains at under kSnapShare
+// (a fillet of radius r leaves its sticks ~0.4 r outside the solid) stays
+// curved, every vertex of it. A band beside one flat only (a flat meeting
+// a curved face), or whose kind (convex or concave) its vertices do not
+// tell, joins as before: nothing says it is round.
+size_t Sharpener::round_strips(std::vector<uint8_t>& mark) {
+  const auto in_band = [&](uint32_t w) { return mark[w] == kStrip || mark[w] == kRimStrip; };
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<uint32_t> band;
+  std::vector<std::pair<int32_t, uint32_t>> votes;  // (flat, neighbours of the band on it)
+  SnapScratch scratch;
+  size_t kept = 0;
+  for (uint32_t v0 = 0; v0 < n; ++v0) {
+    if (mark[v0] != kStrip || seen[v0]) continue;
+    band.assign(1, v0);
+    seen[v0] = 1;
+    for (size_t k = 0; k < band.size(); ++k)
+      for (uint32_t q = adj_off[band[k]]; q < adj_off[band[k] + 1]; ++q)
+        if (const uint32_t w = adj[q]; in_band(w) && !seen[w]) seen[w] = 1, band.push_back(w);
+    // Its two flats: of the flats its vertices neighbour, the pair meeting
+    // at kMinAngle or more with the most neighbours (ties: lower ids).
+    votes.clear();
+    for (uint32_t v : band)
+      for (uint32_t q = adj_off[v]; q < adj_off[v + 1]; ++q)
+        if (const int32_t f = label[adj[q]]; f >= 0) {
+          auto it = std::find_if(votes.begin(), votes.end(), [f](const auto& e) { return e.first == f; });
+          if (it == votes.end()) votes.push_back({f, 1});
+          else ++it->second;
+        }
+    std::sort(votes.begin(), votes.end(),
+              [](const auto& a, const auto& b) { return a.second != b.second ? a.second > b.second : a.first < b.first; });
+    int32_t fa = -1, fb = -1;
+    for (size_t i = 1; i < votes.size() && fb < 0; ++i)
+      for (size_t j = 0; j < i && fb < 0; ++j)
+        if (angle_deg(seg.flats[size_t(votes[i].first)].index_normal, seg.flats[size_t(votes[j].first)].index_normal) >=
+            detail::kMinAngle)
+          fa = votes[j].first, fb = votes[i].first;
+    if (fb < 0) continue;
+    const Flat &FA = seg.flats[size_t(fa)], &FB = seg.flats[size_t(fb)];
+    const Plane A{FA.index_normal, FA.index_offset}, B{FB.index_normal, FB.index_offset};
+    const int kind = detail::edge_kind(A, B, band, [&](uint32_t v) { return x[v]; });
+    if (kind == 0) continue;
+    detail::RoundingEvidence evidence;
+    for (uint32_t v : band)
+      for (uint32_t q = adj_off[v]; q <= adj_off[v + 1]; ++q) {  // v's 1-ring, then v
+        const uint32_t w = q == adj_off[v + 1] ? v : adj[q];
+        evidence.add(A, B, kind, s.inside_sample(w), s.outside_sample(w));
+      }
+    if (evidence.forbids(detail::kRoundBorderRadius)) continue;
+    size_t explained = 0;
+    for (uint32_t v : band) {
+      int32_t f;
+      double t;
+      explained += solid_crossing(v, false, uint32_t(detail::kSnapRings), scratch, f, t);
+    }
+    if (double(explained) >= detail::kSnapShare * double(band.size())) continue;
+    for (uint32_t v : band) mark[v] = 0;
+    ++kept;
+  }
+  return kept;
+}
+
 void Sharpener::snap_to_flats() {
   // Candidates: curved vertices, and members up to 2 rings from a border.
   const std::vector<uint32_t> depth = detail::region_border_rings(seg.region, 2, adj_off, adj);
@@ -159,6 +233,7 @@ void Sharpener::join_leftovers() {
       for (uint32_t v : patch) small[v] = kLeftover;
   });
   thin_strips(small);
+  if (o.passes.on(Pass::round_strips)) st.passes.count[size_t(Pass::round_strips)] += round_strips(small);
   std::vector<std::pair<uint32_t, int32_t>> joins;
   std::vector<uint32_t> ring;
   for (uint32_t v = 0; v < n; ++v) {

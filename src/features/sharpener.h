@@ -216,6 +216,10 @@ struct Sharpener {
   // curved face (kRimStrip), not in a strip between flats: join_leftovers
   // lets it join only when the flat's plane crosses its stick.
   void thin_strips(std::vector<uint8_t>& mark);
+  // Beyond the paper (round-strips, issue 75): a strip is judged as a whole,
+  // with its pockets: a resolved fillet between two flats stays curved.
+  // See sharpen_labels.cpp. Returns the strips kept curved.
+  size_t round_strips(std::vector<uint8_t>& mark);
 
   // Calls f(patch) for each connected patch of curved vertices (label < 0).
   template <class F>

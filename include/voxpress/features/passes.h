@@ -56,6 +56,7 @@ enum class Pass : uint8_t {
   leftovers,             // beyond: curved patches too small for a face (chamfer leftovers) join a flat
   strips,                // rule: ... and so do thin curved strips between flats
   rim_pockets,           // rule: a pocket of a rim joins its flat only where the plane crosses its stick
+  round_strips,          // rule: a strip between two flats whose samples allow a resolved fillet stays curved
   inherit_junctions,     // beyond: a curved junction that joined a flat passes the border on
   walls,                 // beyond: the rim of a thin plate gets its own plane (both edges sharpened)
   final_crease,          // beyond: curved vertices next to the final junctions placed again
