@@ -6,6 +6,8 @@
 //   build/bench/bench_ablation                       # the table in docs/BENCHMARKS.md
 //   build/bench/bench_ablation --seeds 1,2,3 --res 128 --passes past-crease,snap
 //   build/bench/bench_ablation --cases cad-part,fandisk
+//   build/bench/bench_ablation --decision   # issue 75's table: default against
+//       --no-sharpen and --no-flats per case, with sharp recall and precision
 // Columns per case: result -> truth RMS (voxels), mean normal error
 // (degrees), sharp-edge Hausdorff (voxels, true <-> labelled, where the
 // truth has sharp edges) and labelled sharp edges, each the mean over the
@@ -75,8 +77,8 @@ Case make_case(const std::string& name, int64_t res, int seed, const std::string
 }
 
 struct Figures {
-  double rms = 0, normal = 0, sharp_h = 0, labelled = 0;
-  int sharp_runs = 0, runs = 0;
+  double rms = 0, normal = 0, sharp_h = 0, labelled = 0, recall = 0, precision = 0;
+  int sharp_runs = 0, recall_runs = 0, precision_runs = 0, runs = 0;
   std::vector<std::string> failures;
 };
 
@@ -86,6 +88,66 @@ std::vector<std::string> split(const std::string& s) {
   for (std::string w; std::getline(in, w, ',');)
     if (!w.empty()) out.push_back(w);
   return out;
+}
+
+using Table = std::vector<std::vector<Figures>>;  // [rule][case]
+
+void print_ablation(int64_t res, const std::string& seeds, const std::vector<std::string>& cases,
+                    const std::vector<const Rule*>& chosen, const Table& figures) {
+  std::printf("res %ld, seeds %s; per case: r->t RMS (vox) / normal error (deg) / sharp H (vox) / labelled sharp "
+              "edges, means over the seeds; [x%%]: r->t RMS change against the default\n\n| pass off | what it does |",
+              long(res), seeds.c_str());
+  for (const auto& c : cases) std::printf(" %s |", c.c_str());
+  std::printf("\n|---|---|");
+  for (size_t i = 0; i < cases.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  for (size_t ri = 0; ri < chosen.size(); ++ri) {
+    std::printf("| %s | %s |", chosen[ri]->name.c_str(), chosen[ri]->what.c_str());
+    for (size_t ci = 0; ci < cases.size(); ++ci) {
+      const Figures& f = figures[ri][ci];
+      const Figures& d = figures[0][ci];
+      const double rms = f.rms / f.runs;
+      std::printf(" %.4f", rms);
+      if (ri > 0) std::printf(" [%+.0f%%]", 100 * (rms / (d.rms / d.runs) - 1));
+      std::printf(" / %.2f / ", f.normal / f.runs);
+      if (f.sharp_runs) {
+        std::printf("%.2f", f.sharp_h / f.sharp_runs);
+      } else {
+        std::printf("-");
+      }
+      std::printf(" / %.0f |", f.labelled / f.runs);
+    }
+    std::printf("\n");
+  }
+}
+
+// Issue 75's decision table: rows are cases; the default's RMS against the
+// best of --no-sharpen (rule `sharpen` off) and --no-flats (`flats` off),
+// and the default's sharp recall / precision and labelled edges.
+void print_decision(int64_t res, const std::string& seeds, const std::vector<std::string>& cases, const Table& figures) {
+  std::printf("res %ld, seeds %s; r->t RMS (vox), means over the seeds; default / best: the default over the better of "
+              "--no-sharpen and --no-flats (issue 75: <= 1.03); recall / precision: of the true sharp curves (dihedral "
+              "> 30 deg) within 0.5 vox, means over the seeds\n\n",
+              long(res), seeds.c_str());
+  std::printf("| case | default | --no-sharpen | --no-flats | default / best | sharp recall / precision | labelled |\n");
+  std::printf("|---|---:|---:|---:|---:|---|---:|\n");
+  const auto mean = [](double sum, int n) { return n ? sum / n : 0.0; };
+  for (size_t ci = 0; ci < cases.size(); ++ci) {
+    const Figures &d = figures[0][ci], &nf = figures[1][ci], &ns = figures[2][ci];
+    const double a = d.rms / d.runs, b = ns.rms / ns.runs, c = nf.rms / nf.runs;
+    std::printf("| %s | %.4f | %.4f | %.4f | %.3f | ", cases[ci].c_str(), a, b, c, a / std::min(b, c));
+    if (d.recall_runs) {
+      std::printf("%.1f / ", 100 * mean(d.recall, d.recall_runs));
+    } else {
+      std::printf("- / ");
+    }
+    if (d.precision_runs) {
+      std::printf("%.1f %%", 100 * mean(d.precision, d.precision_runs));
+    } else {
+      std::printf("-");
+    }
+    std::printf(" | %.0f |\n", d.labelled / d.runs);
+  }
 }
 
 }  // namespace
@@ -100,7 +162,11 @@ int main(int argc, char** argv) {
   app.add_option("--res", res, "Resolution")->capture_default_str();
   app.add_option("--passes", rules_arg, "Only these passes (default and flats always run)");
   app.add_option("--data", data, "The shared data folder")->capture_default_str();
+  bool decision = false;
+  app.add_flag("--decision", decision,
+               "Issue 75's table: the default against --no-sharpen and --no-flats, one row per case");
   CLI11_PARSE(app, argc, argv);
+  if (decision) rules_arg = "sharpen";
   std::vector<int> seeds;
   for (const auto& s : split(seeds_arg)) seeds.push_back(std::stoi(s));
   const auto only = split(rules_arg);
@@ -130,6 +196,8 @@ int main(int argc, char** argv) {
         f.normal += e.normal_error_deg;
         f.labelled += double(e.labelled_sharp_edges);
         if (e.sharp_edge_hausdorff_vox) f.sharp_h += *e.sharp_edge_hausdorff_vox, ++f.sharp_runs;
+        if (e.sharp_recall) f.recall += *e.sharp_recall, ++f.recall_runs;
+        if (e.sharp_precision) f.precision += *e.sharp_precision, ++f.precision_runs;
         const MeshCheck mc = check_mesh(r.mesh);
         const uint64_t violations = e.classification_violations.value_or(0);
         if (!mc.ok() || violations)
@@ -139,30 +207,10 @@ int main(int argc, char** argv) {
                      e.result_to_truth_vox.rms);
       }
     }
-  std::printf("res %ld, seeds %s; per case: r->t RMS (vox) / normal error (deg) / sharp H (vox) / labelled sharp "
-              "edges, means over the seeds; [x%%]: r->t RMS change against the default\n\n| pass off | what it does |",
-              long(res), seeds_arg.c_str());
-  for (const auto& c : cases) std::printf(" %s |", c.c_str());
-  std::printf("\n|---|---|");
-  for (size_t i = 0; i < cases.size(); ++i) std::printf("---|");
-  std::printf("\n");
-  for (size_t ri = 0; ri < chosen.size(); ++ri) {
-    std::printf("| %s | %s |", chosen[ri]->name.c_str(), chosen[ri]->what.c_str());
-    for (size_t ci = 0; ci < cases.size(); ++ci) {
-      const Figures& f = figures[ri][ci];
-      const Figures& d = figures[0][ci];
-      const double rms = f.rms / f.runs;
-      std::printf(" %.4f", rms);
-      if (ri > 0) std::printf(" [%+.0f%%]", 100 * (rms / (d.rms / d.runs) - 1));
-      std::printf(" / %.2f / ", f.normal / f.runs);
-      if (f.sharp_runs) {
-        std::printf("%.2f", f.sharp_h / f.sharp_runs);
-      } else {
-        std::printf("-");
-      }
-      std::printf(" / %.0f |", f.labelled / f.runs);
-    }
-    std::printf("\n");
+  if (decision) {
+    print_decision(res, seeds_arg, cases, figures);
+  } else {
+    print_ablation(res, seeds_arg, cases, chosen, figures);
   }
   bool ok = true;
   for (size_t ri = 0; ri < chosen.size(); ++ri)
