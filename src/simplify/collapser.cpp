@@ -78,12 +78,6 @@ bool ErrorQuadric::minimise(Vec3& x) const {
   return x.allFinite();
 }
 
-bool Collapser::Entry::operator<(const Entry& e) const {
-  if (cost != e.cost) return cost > e.cost;
-  if (len2 != e.len2) return len2 > e.len2;
-  return std::tie(a, b) > std::tie(e.a, e.b);
-}
-
 Collapser::Collapser(Mesh& m, const SimplifyOptions& opt)
     : mesh(m), o(opt), tri(m.triangles) {}
 
@@ -321,10 +315,12 @@ void Collapser::apply(const Move& m, const Probe& p) {
     for (uint32_t w : tri[f])
       if (w != u && w != v) vf[w].erase(std::find(vf[w].begin(), vf[w].end(), f));
   }
-  std::vector<uint32_t> keep;
+  std::vector<uint32_t>& keep = keep_;
+  keep.clear();
   for (uint32_t f : vf[v])
     if (face_alive[f]) keep.push_back(f);
-  std::vector<uint32_t> from_u;
+  std::vector<uint32_t>& from_u = from_u_;
+  from_u.clear();
   for (uint32_t f : vf[u]) {
     if (!face_alive[f]) continue;
     for (uint32_t& w : tri[f])
@@ -333,12 +329,13 @@ void Collapser::apply(const Move& m, const Probe& p) {
     from_u.push_back(f);
   }
   std::sort(keep.begin(), keep.end());
-  vf[v] = std::move(keep);
+  vf[v].assign(keep.begin(), keep.end());
   vf[u].clear();
   vertex_alive[u] = 0;
   alive_faces -= p.shared.size();
   // Feature edges of u become v's (flags joined); u-v itself disappears.
-  std::vector<std::pair<uint32_t, uint8_t>> carried;
+  std::vector<std::pair<uint32_t, uint8_t>>& carried = carried_;
+  carried.clear();
   for (uint32_t w : p.nu) {
     const auto it = feature.find(key(u, w));
     if (it == feature.end()) continue;
@@ -377,7 +374,7 @@ void Collapser::apply(const Move& m, const Probe& p) {
 // neighbours) meet no earlier one's; an edge that meets one goes back on
 // the heap for a later round, a stale one (an end removed or changed since
 // it was pushed) is dropped. Returns how many were taken.
-size_t Collapser::select(std::priority_queue<Entry>& heap, uint64_t want) {
+size_t Collapser::select(Heap& heap, uint64_t want) {
   want = std::clamp<uint64_t>(want, 1, kRound);
   ++round_id_;
   if (round_.size() < want) round_.resize(want);
@@ -386,7 +383,7 @@ size_t Collapser::select(std::priority_queue<Entry>& heap, uint64_t want) {
   for (size_t looked = 0; n < want && looked < kLook * want && !heap.empty();) {
     const Entry e = heap.top();
     heap.pop();
-    if (!vertex_alive[e.a] || !vertex_alive[e.b] || stamp[e.a] != e.sa || stamp[e.b] != e.sb) continue;
+    if (stale(e)) continue;
     ++looked;
     if (claim_[e.a] == round_id_ || claim_[e.b] == round_id_) {
       later.push_back(e);
@@ -448,7 +445,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     if (has[i]) first[edges++] = first[i];
   first.resize(edges);
   has = {};
-  std::priority_queue<Entry> heap(std::less<Entry>(), std::move(first));
+  Heap heap(std::move(first));
   const uint64_t target = o.faces;
   ProgressCounter progress(o.progress, "simplify", target < st.faces_before ? (st.faces_before - target) / 2 : 0);
   claim_.assign(xp.size(), 0);
@@ -522,6 +519,9 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     });
     for (const auto& entries : fresh)
       for (const Entry& e : entries) heap.push(e);
+    // Over two entries per live edge (3/2 per face): the stale ones go. The
+    // next pop is the same either way (a stale entry is never taken).
+    if (heap.size() > 3 * alive_faces) heap.prune([&](const Entry& e) { return stale(e); });
     progress.add(kept.size());
     kept.clear();
     if (2 * alive_faces < grid_faces) rebuild_grid();
