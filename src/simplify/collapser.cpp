@@ -389,17 +389,21 @@ size_t Collapser::select(Heap& heap, uint64_t want) {
       later.push_back(e);
       continue;
     }
-    neighbours(e.a, around);
-    neighbours(e.b, ring_b);
-    const auto taken = [&](uint32_t w) { return claim_[w] == round_id_; };
-    if (std::any_of(around.begin(), around.end(), taken) || std::any_of(ring_b.begin(), ring_b.end(), taken)) {
+    // The closed neighbourhoods of a and b: every corner of their faces.
+    bool free = true;
+    for (uint32_t v : {e.a, e.b})
+      for (uint32_t f : vf[v])
+        for (uint32_t w : tri[f]) free = free && claim_[w] != round_id_;
+    if (!free) {
       later.push_back(e);
       continue;
     }
-    for (uint32_t w : around) claim_[w] = round_id_;
-    for (uint32_t w : ring_b) claim_[w] = round_id_;
+    for (uint32_t v : {e.a, e.b})
+      for (uint32_t f : vf[v])
+        for (uint32_t w : tri[f]) claim_[w] = round_id_;
     Candidate& c = round_[n++];
-    c.n = moves(e.a, e.b, c.mv);
+    c.a = e.a;
+    c.b = e.b;
   }
   for (const Entry& e : later) heap.push(e);
   return n;
@@ -465,6 +469,7 @@ SimplifyStats Collapser::run(std::vector<uint32_t>* vertex_map) {
     detail::parallel_ranges(n, 1, [&](detail::IndexRange r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
         Candidate& c = round_[i];
+        c.n = moves(c.a, c.b, c.mv);  // reads the state before the round, as the checks do
         c.accepted = -1;
         const auto try_from = [&](int first_move) {  // the first of mv[first_move..n) to pass
           for (int k = first_move; k < c.n && c.accepted < 0; ++k)

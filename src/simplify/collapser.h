@@ -79,6 +79,7 @@ class Collapser {
   /// An edge of the heap taken into a round: its moves, cheapest first (and
   /// the lifted ones, lift()), and the first that passed its checks (-1: none).
   struct Candidate {
+    uint32_t a = 0, b = 0;  // the edge (its moves are made in the round's parallel checks)
     Move mv[5];
     Verdict verdict[5];
     int n = 0, accepted = -1;
@@ -157,7 +158,7 @@ class Collapser {
   std::vector<Candidate> round_;      // the moves of the current round
   std::vector<uint32_t> claim_;       // per vertex: the last round whose footprint holds it
   uint32_t round_id_ = 0;
-  std::vector<uint32_t> around, ring_b, keep_, from_u_;  // scratch of the serial steps
+  std::vector<uint32_t> around, keep_, from_u_;  // scratch of the serial steps
   std::vector<std::pair<uint32_t, uint8_t>> carried_;
 };
 
