@@ -19,7 +19,7 @@ def main():
     ap.add_argument("files", nargs="+")
     ap.add_argument("--passes", action="store_true", help="also every feature pass: seconds (count)")
     args = ap.parse_args()
-    stats = [(f, json.load(open(f))) for f in args.files]
+    stats = [(f, flatten(json.load(open(f)))) for f in args.files]
     stages = sorted({k for _, s in stats for k in s.get("seconds", {})}, key=lambda k: (k != "total", k))
     flats = sorted({k for _, s in stats for k in s.get("flats", {}).get("seconds", {})})
     simp = any("simplify" in s for _, s in stats)
@@ -40,6 +40,19 @@ def main():
         for f, s in stats:
             passes = ", ".join(f"{p['name']} {p['seconds']:.2f} s ({p['count']})" for p in s.get("passes", []))
             print(f"\n{f} passes: {passes}")
+
+
+def flatten(s):
+    """A label map's run (`press --labels`) keeps its stages under shared_surface: lifted to the top."""
+    sh = s.get("shared_surface")
+    if not sh:
+        return s
+    s = dict(s)
+    s["seconds"] = {**s.get("seconds", {}), **sh.get("seconds", {})}
+    for k in ("passes", "sharpen", "simplify"):
+        if k in sh:
+            s[k] = sh[k]
+    return s
 
 
 if __name__ == "__main__":

@@ -87,23 +87,6 @@ nlohmann::json sharpen_json(const SharpenStats& st, const SharpenOptions& o) {
           {"seconds", st.seconds}};
 }
 
-// The feature layer's pass table as run: name, paper section, stage, rule
-// (a decision inside a pass) or step, on/off, seconds and the pass's own
-// count (vertices placed, flats found, ...).
-nlohmann::json passes_json(const PassSet& on, const PassTimes& t) {
-  static const char* const stages[] = {"detect", "press", "crease-round", "fit", "sharpen"};
-  nlohmann::json list = nlohmann::json::array();
-  for (const PassInfo& p : feature_passes())
-    list.push_back({{"name", p.name},
-                    {"section", p.section},
-                    {"stage", stages[size_t(p.stage)]},
-                    {"rule", p.run == nullptr},
-                    {"enabled", on.on(p.pass)},
-                    {"seconds", t.seconds[size_t(p.pass)]},
-                    {"count", t.count[size_t(p.pass)]}});
-  return list;
-}
-
 // The sharp feature curves alone: their vertices and edges, no faces.
 void write_features(const std::string& path, const Mesh& mesh) {
   Mesh f;

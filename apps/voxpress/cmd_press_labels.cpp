@@ -232,6 +232,7 @@ void run_press_labels(const std::string& input, const InputOptions& in, const Su
       if (src.surface) r.seconds_extract = src.seconds_extract;
       shared_stats = shared_json(r);
       if (so.simplify.faces || so.simplify.max_error) shared_stats["simplify"] = simplify_stats_json(r.simplify, so.simplify);
+      shared_stats["passes"] = passes_json(so.passes, r.passes);
       pieces = shared_pieces(r, chosen);
       combined = interfaces_mesh(r.surface);
     } else {

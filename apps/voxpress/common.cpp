@@ -396,4 +396,21 @@ Vec3 parse_vec3(const std::string& text, const std::string& option) {
   return v;
 }
 
+// The feature layer's pass table as run: name, paper section, stage, rule
+// (a decision inside a pass) or step, on/off, seconds and the pass's own
+// count (vertices placed, flats found, ...).
+nlohmann::json passes_json(const PassSet& on, const PassTimes& t) {
+  static const char* const stages[] = {"detect", "press", "crease-round", "fit", "sharpen"};
+  nlohmann::json list = nlohmann::json::array();
+  for (const PassInfo& p : feature_passes())
+    list.push_back({{"name", p.name},
+                    {"section", p.section},
+                    {"stage", stages[size_t(p.stage)]},
+                    {"rule", p.run == nullptr},
+                    {"enabled", on.on(p.pass)},
+                    {"seconds", t.seconds[size_t(p.pass)]},
+                    {"count", t.count[size_t(p.pass)]}});
+  return list;
+}
+
 }  // namespace voxpress::cli

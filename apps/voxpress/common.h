@@ -103,6 +103,8 @@ nlohmann::json smooth_stats_json(const SmoothStats& st);
 /// Adds --faces and --max-error (the simplifier) to a command.
 void bind_simplify(CLI::App& cmd, SimplifyOptions& o);
 nlohmann::json simplify_stats_json(const SimplifyStats& st, const SimplifyOptions& o);
+// The feature layer's pass table as run (--stats-json "passes").
+nlohmann::json passes_json(const PassSet& on, const PassTimes& t);
 
 /// `--check` of extract and press: check_mesh and the classification against
 /// the volume, before anything is written. When strict (methods that promise

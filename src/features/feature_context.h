@@ -35,13 +35,15 @@ struct CreaseRound {
   bool last = false;             // the last round: the one whose counts are reported
 };
 
-// Stage::fit's state.
+// Stage::fit's state. `only` (optional): the vertices that may move (a
+// label's part of a shared surface, labels/shared_fit.cpp).
 struct FitStage {
   StickSurface& s;
   const FlatSegmentation& seg;
   const Adjacency& graph;
   QuadricFitOptions o;
   QuadricFitStats out;
+  const std::vector<uint8_t>* only = nullptr;
 };
 
 // The state a stage's steps work on: the stage's own (one of the pointers)

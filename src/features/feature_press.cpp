@@ -220,7 +220,7 @@ size_t curved_creases_step(FeatureContext& c) {
 
 size_t quadric_fit_step(FeatureContext& c) {
   FitStage& f = *c.fit;
-  f.out = fit_local_quadrics(f.s, f.seg.region, f.seg.junction, f.o, nullptr, f.graph);
+  f.out = fit_local_quadrics(f.s, f.seg.region, f.seg.junction, f.o, f.only, f.graph);
   return f.out.moved;
 }
 

@@ -12,14 +12,16 @@
 #include "cube_check.h"
 #include "label_view.h"
 #include "core/parallel.h"
+#include "features/feature_context.h"
 
 namespace voxpress {
 
 SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, const std::vector<LabelInfo>& labels,
-                                   const SharedFlats* flats, const QuadricFitOptions& options) {
+                                   const SharedFlats* flats, const QuadricFitOptions& options, const PassSet& passes) {
   const auto t0 = std::chrono::steady_clock::now();
   SharedFitStats st;
-  if (options.rings <= 0) return st;
+  // Nothing to fit: no rings, or the table's driver would run no fit step.
+  if (options.rings <= 0 || !runs(feature_passes()[size_t(Pass::quadric_fit)], passes)) return st;
   // Every label of `labels` takes part (by its index in s.labels).
   const std::vector<size_t> info_of = detail::listed_labels(s, labels);
   std::vector<uint8_t> takes_part(s.labels.size(), 0);
@@ -32,10 +34,10 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
   struct Fit {
     std::vector<std::pair<uint32_t, Vec3>> moved;  // shared vertex, index-space position
     size_t cubes = 0, fitted = 0;
+    PassTimes times;
   };
   std::vector<Fit> fits(todo.size());
-  const std::vector<int32_t> no_regions;
-  const std::vector<uint8_t> no_junctions;
+  const FlatSegmentation no_flats;
   detail::parallel_for(todo.size(), [&](size_t i) {
     const uint32_t l = todo[i];
     const LabelInfo& info = labels[info_of[l]];
@@ -50,8 +52,13 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
     const std::vector<double> before = v.surf.t;
     std::vector<uint8_t> only(v.fixed.size());
     for (size_t k = 0; k < only.size(); ++k) only[k] = !v.fixed[k];
-    f.fitted = fit_local_quadrics(v.surf, seg ? seg->region : no_regions, seg ? seg->junction : no_junctions, options,
-                                  &only).fitted;
+    // The binary pipeline's fit stage on the label's view (one driver, one pass table).
+    const detail::Adjacency graph(v.surf.stick_count(), v.surf.triangles);
+    detail::FitStage fit{v.surf, seg ? *seg : no_flats, graph, options, {}, &only};
+    detail::FeatureContext fc{passes, f.times};
+    fc.fit = &fit;
+    detail::run_stage(Stage::fit, fc);
+    f.fitted = fit.out.fitted;
     for (size_t k = 0; k < v.surf.stick_count(); ++k)
       if (!v.fixed[k] && v.surf.t[k] != before[k]) f.moved.push_back({v.idx[k], v.shared_position(k)});
   });
@@ -65,6 +72,7 @@ SharedFitStats fit_shared_quadrics(SharedSurface& s, const LabelMasks& masks, co
   const std::vector<Vec3> back = x;
   std::vector<uint8_t> reset(n, 1);  // put_back moves only the vertices the fit moved
   for (const Fit& f : fits) {
+    st.passes.add(f.times);
     st.labels += f.cubes > 0;
     st.cubes += f.cubes;
     st.fitted += f.fitted;

@@ -49,10 +49,10 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
     r.flats = find_shared_flats(masks, r.surface, table.labels, po, fo, o.progress);
   }
   r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr);
-  if (o.passes.on(Pass::quadric_fit)) {
+  {
     QuadricFitOptions fit = o.fit;
     fit.margin = po.margin;
-    r.fit = fit_shared_quadrics(r.surface, masks, table.labels, r.flats ? &*r.flats : nullptr, fit);
+    r.fit = fit_shared_quadrics(r.surface, masks, table.labels, r.flats ? &*r.flats : nullptr, fit, o.passes);
   }
   if (r.flats && o.passes.on(Pass::sharpen)) {
     SharpenOptions so = o.sharp;
@@ -60,6 +60,10 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
     r.sharpen = sharpen_shared(r.surface, *r.flats, masks, table.labels, so);
   }
   if (o.simplify.faces || o.simplify.max_error) r.simplify = simplify_shared(r.surface, o.simplify);
+  if (r.flats)
+    for (const FlatSegmentation& seg : r.flats->segmentations) r.passes.add(seg.stats.passes);
+  r.passes.add(r.fit.passes);
+  r.passes.add(r.sharpen.passes);
   return r;
 }
 

@@ -328,6 +328,7 @@ SharedSharpenStats sharpen_shared(SharedSurface& s, const SharedFlats& flats, co
   s.mesh.normals.clear();
   for (size_t i = 0; i < edits.size(); ++i) {
     st.cubes += edits[i].cubes;
+    st.passes.add(edits[i].stats.passes);
     if (!use[i]) continue;
     ++st.labels;
     st.inserted += edits[i].stats.inserted + edits[i].stats.corners;

@@ -7,6 +7,7 @@
 // same bytes for 1 and N threads.
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -172,6 +173,30 @@ TEST(SharedPress, AssemblyOfBoxesGetsItsFlats) {
       EXPECT_LT(rms(m), 0.8 * rms(p));  // measured 0.16-0.68 over these seeds
     }
   }
+}
+
+TEST(SharedLabels, EachLabelRunsThePassTable) {
+  // The shared surface's stages run the binary pipeline's pass table per
+  // label through its driver: each label's detection, fit and sharpening
+  // appear in the trace, and switching a pass off is honoured.
+  const test::Assembly a = test::assembly(1);
+  const LabelTable table = label_table(a.volume);
+  const SharedLabels on = press_shared_labels(a.volume, table, SurfaceOptions{});
+  const auto times = [](const SharedLabels& r, Pass p) {
+    return size_t(std::count(r.passes.trace.begin(), r.passes.trace.end(), p));
+  };
+  EXPECT_GT(on.fit.labels, 0u);
+  EXPECT_EQ(times(on, Pass::quadric_fit), on.fit.labels);
+  EXPECT_GT(on.passes.count[size_t(Pass::quadric_fit)], 0u);
+  EXPECT_GE(times(on, Pass::flats), 2u) << "both boxes' detection";
+  EXPECT_EQ(times(on, Pass::moves), on.sharpen.labels);
+  SurfaceOptions off;
+  off.passes.disable(Pass::quadric_fit);
+  const SharedLabels r = press_shared_labels(a.volume, table, off);
+  EXPECT_EQ(times(r, Pass::quadric_fit), 0u);
+  EXPECT_EQ(r.fit.moved, 0u);
+  for (uint32_t L = 1; L < r.surface.labels.size(); ++L)
+    test::expect_guarantees(label_mesh(r.surface, L), test::whole_mask(a.volume, double(r.surface.labels[L])));
 }
 
 TEST(SharedPress, SameBytesForOneAndManyThreads) {

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "voxpress/features/passes.h"
 #include "voxpress/labels/labels.h"
 #include "voxpress/labels/shared_flats.h"
 #include "voxpress/labels/shared_surface.h"
@@ -35,12 +36,16 @@ struct SharedFitStats {
   size_t moved = 0;           ///< stick vertices that took their fitted t
   size_t cubes_put_back = 0;  ///< cubes whose moved vertices went back (exact check)
   double seconds = 0;
+  PassTimes passes;           ///< Stage::fit's passes, summed over the labels (label order)
 };
 
 /// Fits `surface` (pressed by press_shared) in place; `labels` (with their
 /// boxes) and `masks` as for find_shared_flats, whose result `flats` (or
 /// null) excludes each label's flat and junction vertices from the fit.
+/// Each label runs the feature layer's Stage::fit (its `quadric-fit` pass)
+/// with `passes`, as smooth_surface does on a binary volume.
 SharedFitStats fit_shared_quadrics(SharedSurface& surface, const LabelMasks& masks, const std::vector<LabelInfo>& labels,
-                                   const SharedFlats* flats, const QuadricFitOptions& options = {});
+                                   const SharedFlats* flats, const QuadricFitOptions& options = {},
+                                   const PassSet& passes = {});
 
 }  // namespace voxpress

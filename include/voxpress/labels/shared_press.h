@@ -84,6 +84,9 @@ struct SharedLabels {
   SharedSharpenStats sharpen;  ///< labels with flats, when options.passes has Pass::sharpen
   SimplifyStats simplify;      ///< with options.simplify (faces: the shared surface's triangles)
   double seconds_extract = 0;
+  /// The feature layer's passes as each label ran them (its detection, fit
+  /// and sharpening), summed over the labels: the binary pipeline's table.
+  PassTimes passes;
 };
 SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& options);
 /// The same on a shared surface already extracted from `source` (press --labels --chunk

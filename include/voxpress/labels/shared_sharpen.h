@@ -51,6 +51,7 @@ struct SharedSharpenStats {
   size_t taken_back = 0;      ///< changes taken back where they met another surface (vertices)
   size_t labels_undone = 0;   ///< labels whose sharpening was undone whole (nothing left to take back)
   double seconds = 0;
+  PassTimes passes;           ///< Stage::sharpen's passes, summed over the labels (label order)
 };
 
 /// Sharpens `surface` (pressed by press_shared with `flats`, found by
