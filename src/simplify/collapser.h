@@ -50,8 +50,7 @@ class Collapser {
   struct Entry {
     double cost, len2;
     uint32_t a, b, sa, sb;
-    // A max-heap of this order pops the cheapest (inline: the heap's
-    // compares were 6.5 % of a one-thread `press --faces`, perf).
+    // A max-heap of this order pops the cheapest.
     bool operator<(const Entry& e) const {
       if (cost != e.cost) return cost > e.cost;
       if (len2 != e.len2) return len2 > e.len2;
