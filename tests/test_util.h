@@ -176,6 +176,24 @@ inline FilletedBox filleted_box(int64_t res, int seed, double fillet) {
   b.truth = shape_truth(ShapeKind::box, b.shape.linear, b.shape.translation, b.shape.fillet);
   return b;
 }
+/// A rule of the feature layer on (every pass) and off, on
+/// filleted_box(res, seed, fillet): both results and the rule's count with
+/// it on; the default's guarantees are checked.
+struct RuleOnOff {
+  FilletedBox box;
+  SurfaceResult on, off;
+  size_t count = 0;
+};
+inline RuleOnOff fillet_rule_on_off(int64_t res, int seed, double fillet, Pass rule) {
+  RuleOnOff r{filleted_box(res, seed, fillet), {}, {}, 0};
+  SurfaceOptions off;
+  off.passes.disable(rule);
+  r.on = smooth_surface(r.box.shape.volume);
+  r.off = smooth_surface(r.box.shape.volume, off);
+  expect_guarantees(r.on.mesh, r.box.shape.volume);
+  r.count = r.on.pass_times.count[size_t(rule)];
+  return r;
+}
 /// Lines in a command's output (one error = one line).
 inline size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 

@@ -293,25 +293,18 @@ TEST(Flats, FilletsTheLatticeResolvesAreNotFlattened) {
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     for (double r : {0.0, 2.5}) {
-      const test::FilletedBox box = test::filleted_box(64, seed, r);
-      const GeneratedShape& g = box.shape;
-      const auto& truth = box.truth;
-      SurfaceOptions off;
-      off.passes.disable(Pass::round_borders);
-      const SurfaceResult a = smooth_surface(g.volume), b = smooth_surface(g.volume, off);
-      test::expect_guarantees(a.mesh, g.volume);
-      const size_t released = a.pass_times.count[size_t(Pass::round_borders)];
+      const test::RuleOnOff t = test::fillet_rule_on_off(64, seed, r, Pass::round_borders);
       if (r == 0) {
-        EXPECT_EQ(released, 0u);
+        EXPECT_EQ(t.count, 0u);
         continue;
       }
-      EXPECT_GT(released, 0u);
+      EXPECT_GT(t.count, 0u);
       EvalOptions eo;
-      eo.volume = &g.volume;
+      eo.volume = &t.box.shape.volume;
       eo.samples = 40000;
       eo.self_intersections = false;
-      const double on_rms = evaluate(a.mesh, *truth, eo).result_to_truth_vox.rms;
-      const double off_rms = evaluate(b.mesh, *truth, eo).result_to_truth_vox.rms;
+      const double on_rms = evaluate(t.on.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
+      const double off_rms = evaluate(t.off.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
       EXPECT_LT(on_rms, 0.9 * off_rms);
     }
   }

@@ -473,20 +473,15 @@ TEST(Sharpen, StripsOfResolvedFilletsStayCurved) {
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     for (double r : {0.0, 3.0}) {
-      const test::FilletedBox box = test::filleted_box(64, seed, r);
-      const GeneratedShape& g = box.shape;
-      SurfaceOptions off;
-      off.passes.disable(Pass::round_strips);
-      const SurfaceResult on = smooth_surface(g.volume, {}), before = smooth_surface(g.volume, off);
-      expect_valid(on.mesh, g.volume);
-      const size_t kept = on.pass_times.count[size_t(Pass::round_strips)];
+      const test::RuleOnOff t = test::fillet_rule_on_off(64, seed, r, Pass::round_strips);
       if (r == 0) {
-        EXPECT_EQ(kept, 0u);
+        EXPECT_EQ(t.count, 0u);
         continue;
       }
-      EXPECT_GT(kept, 0u);
-      const double a = eval(on.mesh, *box.truth, g.volume).result_to_truth_vox.rms;
-      const double b = eval(before.mesh, *box.truth, g.volume).result_to_truth_vox.rms;
+      EXPECT_GT(t.count, 0u);
+      const BinaryVolume& v = t.box.shape.volume;
+      const double a = eval(t.on.mesh, *t.box.truth, v).result_to_truth_vox.rms;
+      const double b = eval(t.off.mesh, *t.box.truth, v).result_to_truth_vox.rms;
       EXPECT_LT(a, b) << "measured 0.0582 against 0.0600, 0.0596 against 0.0641";
     }
   }
