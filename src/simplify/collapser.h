@@ -17,23 +17,11 @@
 #include <unordered_map>
 #include <vector>
 
+#include "simplify/error_quadric.h"
 #include "simplify/face_grid.h"
 #include "voxpress/simplify/simplify.h"
 
 namespace voxpress::detail {
-
-/// Symmetric 4x4 error quadric (Garland and Heckbert 1997): 10 coefficients
-/// xx xy xz xw yy yz yw zz zw ww. (Not smooth/quadric.h's Quadric, a height
-/// field: one name for two classes in one namespace would break the ODR.)
-struct ErrorQuadric {
-  double a[10] = {};
-  /// weight * (n.x - c)^2 with n unit.
-  static ErrorQuadric plane(const Vec3& n, double c, double weight);
-  ErrorQuadric& operator+=(const ErrorQuadric& o);
-  double operator()(const Vec3& x) const;
-  /// The minimiser when the 3x3 part is well conditioned.
-  bool minimise(Vec3& x) const;
-};
 
 class Collapser {
  public:
