@@ -240,6 +240,17 @@ struct RoundingEvidence {
     allow = std::min(allow, cutting_radius(-kind * (a.n.dot(keep) - a.c), -kind * (b.n.dot(keep) - b.c), a.n.dot(b.n), kRoundCap));
     demanded |= std::min(-kind * (a.n.dot(gone) - a.c), -kind * (b.n.dot(gone) - b.c)) > kRoundEvidence;
   }
+  // The sticks of the vertices `vs` and of their 1-rings (adjacency off,
+  // adj), with each stick's inside and outside samples.
+  template <class Inside, class Outside>
+  void add_rings(const Plane& a, const Plane& b, int kind, const std::vector<uint32_t>& vs,
+                 const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj, Inside inside, Outside outside) {
+    for (uint32_t v : vs)
+      for (uint32_t q = off[v]; q <= off[v + 1]; ++q) {  // v's 1-ring, then v
+        const uint32_t w = q == off[v + 1] ? v : adj[q];
+        add(a, b, kind, inside(w), outside(w));
+      }
+  }
   // Round: the samples allow at least `radius` and demand a rounding, and some sample bounds it.
   bool round(double radius) const { return demanded && allow >= radius && allow < kRoundCap; }
   // Sharp: some sample forbids a rounding of `radius` (whether or not one is demanded).

@@ -193,11 +193,8 @@ size_t round_borders(FlatsContext& ctx) {
     const int kind = detail::edge_kind(A, B, chain, [&](uint32_t v) { return S.x[v]; });
     if (kind == 0) continue;
     detail::RoundingEvidence evidence;
-    for (uint32_t v : chain)
-      for (uint32_t q = S.adj_off[v]; q <= S.adj_off[v + 1]; ++q) {  // v's 1-ring, then v
-        const uint32_t w = q == S.adj_off[v + 1] ? v : S.adj[q];
-        evidence.add(A, B, kind, S.inside(w), S.outside(w));
-      }
+    evidence.add_rings(A, B, kind, chain, S.adj_off, S.adj, [&](uint32_t w) { return S.inside(w); },
+                       [&](uint32_t w) { return S.outside(w); });
     if (!evidence.round(detail::kRoundBorderRadius)) continue;
     for (uint32_t v : chain) seg.junction[v] = 0;
     released += chain.size();

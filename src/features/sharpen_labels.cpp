@@ -155,11 +155,8 @@ size_t Sharpener::round_strips(std::vector<uint8_t>& mark) {
     const int kind = detail::edge_kind(A, B, band, [&](uint32_t v) { return x[v]; });
     if (kind == 0) continue;
     detail::RoundingEvidence evidence;
-    for (uint32_t v : band)
-      for (uint32_t q = adj_off[v]; q <= adj_off[v + 1]; ++q) {  // v's 1-ring, then v
-        const uint32_t w = q == adj_off[v + 1] ? v : adj[q];
-        evidence.add(A, B, kind, s.inside_sample(w), s.outside_sample(w));
-      }
+    evidence.add_rings(A, B, kind, band, adj_off, adj, [&](uint32_t w) { return s.inside_sample(w); },
+                       [&](uint32_t w) { return s.outside_sample(w); });
     if (evidence.forbids(detail::kRoundBorderRadius)) continue;
     size_t explained = 0;
     for (uint32_t v : band) {
