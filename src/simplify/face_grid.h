@@ -1,13 +1,17 @@
-// A uniform grid of triangles for the simplifier's clash queries (private).
+// A hierarchy of uniform grids of triangles for the simplifier's clash
+// queries (private).
 //
-// A triangle is listed in every cell its box meets; a query visits the
-// cells its box meets and reports each triangle once. Triangles grow as the
-// mesh is simplified (a flat ends as two triangles across the part), so the
-// simplifier rebuilds the grid with the mean triangle extent as its cell
-// whenever the face count has halved: a triangle stays in a handful of
-// cells and a query's box in a few dozen. The cells are found through an
-// open-addressing table (a node-based map's pointer chasing was most of the
-// query's time: perf on build/bench/bench_simplify).
+// Level l has cells of side `cell` * 4^l; a triangle is listed at the
+// finest level where its box spans at most two cells per axis (so in at
+// most 8 cells), and a query visits the cells its box meets on every
+// level that holds a triangle, reporting each triangle once. A flat
+// simplifies to a few triangles across the part: on one grid such a
+// triangle was listed in hundreds of cells, and moving it rewrote them all
+// (the grid's updates were half of the serial apply on the 256^3 CAD part,
+// `press --faces`). The simplifier rebuilds the grid with the mean triangle
+// extent as its finest cell whenever the face count has halved. The cells
+// are found through open-addressing tables (a node-based map's pointer
+// chasing was most of the query's time: perf on build/bench/bench_simplify).
 #pragma once
 
 #include <algorithm>
@@ -22,114 +26,141 @@ namespace voxpress::detail {
 
 class FaceGrid {
  public:
-  /// Cells of side `cell` (index space); `faces` is the largest face id + 1.
+  /// Finest cells of side `cell` (index space); `faces` is the largest face id + 1.
   void reset(double cell, size_t faces) {
     side_ = cell;
-    keys_.assign(1024, kEmpty);
-    slot_.assign(1024, 0);
-    lists_.clear();
+    for (Level& l : levels_) {
+      l.keys.assign(64, kEmpty);
+      l.slot.assign(64, 0);
+      l.lists.clear();
+      l.faces = 0;
+    }
     range_.assign(faces, {});
   }
-  double side() const { return side_; }
 
   void insert(uint32_t f, const Vec3& lo, const Vec3& hi) {
     Range& r = range_[f];
-    for (int k = 0; k < 3; ++k) {
-      r.lo[k] = cell(lo[k]);
-      r.hi[k] = cell(hi[k]);
-    }
+    r = range_of(lo, hi, level_of(lo, hi));
     r.used = true;
-    visit_cells(r, [&](const std::array<int32_t, 3>&, uint64_t key) { lists_[find_or_add(key)].push_back(f); });
+    Level& l = levels_[r.level];
+    ++l.faces;
+    visit_cells(r, [&](const std::array<int32_t, 3>&, uint64_t key) { l.lists[find_or_add(l, key)].push_back(f); });
   }
 
   void erase(uint32_t f) {
     Range& r = range_[f];
     if (!r.used) return;
+    Level& l = levels_[r.level];
     visit_cells(r, [&](const std::array<int32_t, 3>&, uint64_t key) {
-      std::vector<uint32_t>& v = lists_[find(key)];
+      std::vector<uint32_t>& v = l.lists[find(l, key)];
       *std::find(v.begin(), v.end(), f) = v.back();
       v.pop_back();
     });
+    --l.faces;
     r.used = false;
   }
 
   /// Re-lists f for its new box (nothing to do when it meets the same cells).
   void move(uint32_t f, const Vec3& lo, const Vec3& hi) {
-    Range r;
-    for (int k = 0; k < 3; ++k) {
-      r.lo[k] = cell(lo[k]);
-      r.hi[k] = cell(hi[k]);
-    }
+    const Range r = range_of(lo, hi, level_of(lo, hi));
     const Range& old = range_[f];
-    if (old.used && old.lo == r.lo && old.hi == r.hi) return;
+    if (old.used && old.level == r.level && old.lo == r.lo && old.hi == r.hi) return;
     erase(f);
     insert(f, lo, hi);
   }
 
   /// visit(f) once for every triangle listed in a cell [lo, hi] meets. A
-  /// triangle is reported from the first cell (lowest x, y, z) where its
-  /// cells and the query's meet, so the query writes nothing: queries may
-  /// run in parallel.
+  /// triangle is reported from the first cell (lowest x, y, z) of its level
+  /// where its cells and the query's meet, so the query writes nothing:
+  /// queries may run in parallel.
   template <class F>
   void query(const Vec3& lo, const Vec3& hi, F&& visit) const {
-    Range r;
-    for (int k = 0; k < 3; ++k) {
-      r.lo[k] = cell(lo[k]);
-      r.hi[k] = cell(hi[k]);
+    for (uint8_t k = 0; k < kLevels; ++k) {
+      const Level& l = levels_[k];
+      if (l.faces == 0) continue;
+      const Range r = range_of(lo, hi, k);
+      visit_cells(r, [&](const std::array<int32_t, 3>& c, uint64_t key) {
+        const uint32_t i = find(l, key);
+        if (i == kNone) return;
+        for (uint32_t f : l.lists[i]) {
+          const Range& fr = range_[f];
+          if (c[0] == std::max(r.lo[0], fr.lo[0]) && c[1] == std::max(r.lo[1], fr.lo[1]) &&
+              c[2] == std::max(r.lo[2], fr.lo[2]))
+            visit(f);
+        }
+      });
     }
-    visit_cells(r, [&](const std::array<int32_t, 3>& c, uint64_t key) {
-      const uint32_t i = find(key);
-      if (i == kNone) return;
-      for (uint32_t f : lists_[i]) {
-        const Range& fr = range_[f];
-        if (c[0] == std::max(r.lo[0], fr.lo[0]) && c[1] == std::max(r.lo[1], fr.lo[1]) &&
-            c[2] == std::max(r.lo[2], fr.lo[2]))
-          visit(f);
-      }
-    });
   }
 
  private:
+  static constexpr uint8_t kLevels = 8;  // the coarsest cell: 4^7 = 16384 finest cells
   struct Range {
     std::array<int32_t, 3> lo{}, hi{};
+    uint8_t level = 0;
     bool used = false;
+  };
+  struct Level {
+    std::vector<uint64_t> keys;
+    std::vector<uint32_t> slot;
+    std::vector<std::vector<uint32_t>> lists;
+    size_t faces = 0;  // triangles listed at this level
   };
   static constexpr int64_t kBias = int64_t(1) << 20;  // 21 bits per axis
 
   static constexpr uint64_t kEmpty = ~uint64_t(0);
   static constexpr uint32_t kNone = ~uint32_t(0);
-  size_t home(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & (keys_.size() - 1); }
+  double side(uint8_t level) const { return side_ * double(uint64_t(1) << (2 * level)); }
+  // The finest level whose cell is at least the box's longest side (so the
+  // box spans at most two cells per axis).
+  uint8_t level_of(const Vec3& lo, const Vec3& hi) const {
+    const double e = (hi - lo).maxCoeff();
+    uint8_t k = 0;
+    while (k + 1 < kLevels && side(k) < e) ++k;
+    return k;
+  }
+  Range range_of(const Vec3& lo, const Vec3& hi, uint8_t level) const {
+    Range r;
+    r.level = level;
+    const double s = side(level);
+    for (int k = 0; k < 3; ++k) {
+      r.lo[k] = int32_t(std::floor(lo[k] / s));
+      r.hi[k] = int32_t(std::floor(hi[k] / s));
+    }
+    return r;
+  }
+  static size_t home(const Level& l, uint64_t key) {
+    return size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & (l.keys.size() - 1);
+  }
   // The list of a cell, or kNone (linear probing; cells are never removed,
   // an emptied cell keeps its empty list).
-  uint32_t find(uint64_t key) const {
-    for (size_t i = home(key);; i = (i + 1) & (keys_.size() - 1)) {
-      if (keys_[i] == key) return slot_[i];
-      if (keys_[i] == kEmpty) return kNone;
+  static uint32_t find(const Level& l, uint64_t key) {
+    for (size_t i = home(l, key);; i = (i + 1) & (l.keys.size() - 1)) {
+      if (l.keys[i] == key) return l.slot[i];
+      if (l.keys[i] == kEmpty) return kNone;
     }
   }
-  uint32_t find_or_add(uint64_t key) {
-    if (2 * (lists_.size() + 1) > keys_.size()) {  // keep the table at most half full
-      std::vector<uint64_t> keys(2 * keys_.size(), kEmpty);
+  static uint32_t find_or_add(Level& l, uint64_t key) {
+    if (2 * (l.lists.size() + 1) > l.keys.size()) {  // keep the table at most half full
+      std::vector<uint64_t> keys(2 * l.keys.size(), kEmpty);
       std::vector<uint32_t> slot(keys.size());
-      keys.swap(keys_);
-      slot.swap(slot_);
+      keys.swap(l.keys);
+      slot.swap(l.slot);
       for (size_t j = 0; j < keys.size(); ++j)
         if (keys[j] != kEmpty) {
-          size_t i = home(keys[j]);
-          while (keys_[i] != kEmpty) i = (i + 1) & (keys_.size() - 1);
-          keys_[i] = keys[j];
-          slot_[i] = slot[j];
+          size_t i = home(l, keys[j]);
+          while (l.keys[i] != kEmpty) i = (i + 1) & (l.keys.size() - 1);
+          l.keys[i] = keys[j];
+          l.slot[i] = slot[j];
         }
     }
-    size_t i = home(key);
-    for (; keys_[i] != kEmpty; i = (i + 1) & (keys_.size() - 1))
-      if (keys_[i] == key) return slot_[i];
-    keys_[i] = key;
-    slot_[i] = uint32_t(lists_.size());
-    lists_.emplace_back();
-    return slot_[i];
+    size_t i = home(l, key);
+    for (; l.keys[i] != kEmpty; i = (i + 1) & (l.keys.size() - 1))
+      if (l.keys[i] == key) return l.slot[i];
+    l.keys[i] = key;
+    l.slot[i] = uint32_t(l.lists.size());
+    l.lists.emplace_back();
+    return l.slot[i];
   }
-  int32_t cell(double x) const { return int32_t(std::floor(x / side_)); }
   template <class F>
   static void visit_cells(const Range& r, F&& f) {
     const uint64_t m = (uint64_t(1) << 21) - 1;
@@ -142,9 +173,7 @@ class FaceGrid {
   }
 
   double side_ = 1;
-  std::vector<uint64_t> keys_;
-  std::vector<uint32_t> slot_;
-  std::vector<std::vector<uint32_t>> lists_;
+  std::array<Level, kLevels> levels_;
   std::vector<Range> range_;
 };
 
