@@ -197,4 +197,31 @@ inline RuleOnOff fillet_rule_on_off(int64_t res, int seed, double fillet, Pass r
 /// Lines in a command's output (one error = one line).
 inline size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
 
+// The driver's trace, cut where the table index stops increasing, is a
+// sequence of stage runs; each must be exactly its stage's steps that
+// runs() allows, in table order, and the stages must come in pipeline
+// order (detection rounds, crease rounds, fit, sharpening): the pipeline's
+// one sequence (src/smooth/sequence.h), for a binary run and a label map's
+// shared surface (whose stages run once per label) alike.
+inline void expect_trace_follows_table(const std::vector<Pass>& trace, const PassSet& on) {
+  const auto& table = feature_passes();
+  std::vector<std::vector<Pass>> runs_of_stage;
+  for (size_t i = 0; i < trace.size(); ++i) {
+    if (i == 0 || size_t(trace[i]) <= size_t(trace[i - 1]) || table[size_t(trace[i])].stage != table[size_t(trace[i - 1])].stage)
+      runs_of_stage.emplace_back();
+    runs_of_stage.back().push_back(trace[i]);
+  }
+  ASSERT_FALSE(runs_of_stage.empty());
+  Stage last = Stage::detect;
+  for (const std::vector<Pass>& r : runs_of_stage) {
+    const Stage stage = table[size_t(r.front())].stage;
+    EXPECT_GE(stage, last);
+    last = stage;
+    std::vector<Pass> expected;
+    for (const PassInfo& p : table)
+      if (p.stage == stage && p.run && runs(p, on)) expected.push_back(p.pass);
+    EXPECT_EQ(r, expected) << "stage " << int(stage);
+  }
+}
+
 }  // namespace voxpress::test

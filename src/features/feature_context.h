@@ -7,6 +7,8 @@
 // step records itself in `times` (its rules' seconds) is not counted twice.
 #pragma once
 
+#include <memory>
+
 #include <vector>
 
 #include "smooth/surface_graph.h"
@@ -71,6 +73,23 @@ size_t fit_curved_creases(StickSurface& surface, const FlatSegmentation& flats, 
                           std::vector<uint8_t>& fixed, std::vector<uint8_t>* placed, const Adjacency& graph);
 FeaturePressStats press_with_flats(StickSurface& surface, const SliceCurves& curves, const PressOptions& options,
                                    const FlatOptions* flat_options, FlatSegmentation* flats, const Adjacency& graph);
+
+// press_with_flats as the pipeline's two steps (smooth/sequence.h): the
+// flats (the layout, the estimates, the detection; the flats applied to the
+// surface), then the press (the final press, the crease rounds). FlatRun
+// carries what the first leaves the second.
+struct Layout;
+struct FlatRun {
+  struct Estimates;  // feature_press.cpp
+  std::unique_ptr<Layout> layout;
+  std::unique_ptr<Estimates> estimates;
+  FlatRun();
+  ~FlatRun();
+};
+void find_flats_of(StickSurface& surface, const SliceCurves& curves, const PressOptions& options,
+                   const FlatOptions& flat_options, const Adjacency& graph, FlatRun& run);
+FeaturePressStats press_flat_run(StickSurface& surface, FlatRun& run, const PressOptions& options,
+                                 const FlatOptions& flat_options, FlatSegmentation* flats, const Adjacency& graph);
 SharpenResult sharpen(const StickSurface& surface, const FlatSegmentation& flats, const SharpenOptions& options,
                       const Adjacency& graph);
 

@@ -28,6 +28,18 @@ void apply_flats(StickSurface& s, const FlatSegmentation& f) {
   }
 }
 
+// What segment() leaves the press: the segmentation, `est` the last
+// estimate, `plain` whether it is still the plain press of the surface (no
+// flats were frozen in it), with `first` its stats and `options` the first
+// estimate's press.
+struct detail::FlatRun::Estimates {
+  FlatSegmentation seg;
+  StickSurface est;
+  PressStats first;
+  PressOptions options;
+  bool plain = true;
+};
+
 namespace {
 
 std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
@@ -55,17 +67,8 @@ PressOptions estimate_options(const PressOptions& po, int levels) {
 
 // The flats of a surface from its estimates (Section 4, last paragraph):
 // press a copy, detect, and (beyond the paper) press again with the first
-// flats frozen and detect from scratch. `est` ends as the last estimate;
-// `plain` tells whether it is still the plain press of the surface (no
-// flats were frozen in it), with `first` its stats and `options` the first
-// estimate's press.
-struct Segmented {
-  FlatSegmentation seg;
-  StickSurface est;
-  PressStats first;
-  PressOptions options;
-  bool plain = true;
-};
+// flats frozen and detect from scratch.
+using Segmented = detail::FlatRun::Estimates;
 
 Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail::Layout& layout,
                   const PressOptions& po, const FlatOptions& fo, const detail::Adjacency& graph) {
@@ -127,33 +130,39 @@ FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, c
                                   fo ? detail::Adjacency(s.stick_count(), s.triangles) : detail::Adjacency());
 }
 
-FeaturePressStats detail::press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
-                                           const FlatOptions* fo, FlatSegmentation* out, const Adjacency& graph) {
+// The pipeline's flats step (smooth/sequence.h): the layout, the estimates
+// and the detection (segment), the flats applied to the surface.
+detail::FlatRun::FlatRun() = default;
+detail::FlatRun::~FlatRun() = default;
+
+void detail::find_flats_of(StickSurface& s, const SliceCurves& curves, const PressOptions& po, const FlatOptions& fo,
+                           const Adjacency& graph, FlatRun& run) {
+  run.layout = std::make_unique<Layout>();
+  detail::make_layout(s, curves, *run.layout);
+  run.estimates = std::make_unique<FlatRun::Estimates>();
+  *run.estimates = segment(s, curves, *run.layout, po, fo, graph);
+  apply_flats(s, run.estimates->seg);
+}
+
+// The pipeline's press step after find_flats_of: the final press with the
+// flats frozen, then the crease rounds; the segmentation ends in `out`.
+FeaturePressStats detail::press_flat_run(StickSurface& s, FlatRun& run, const PressOptions& po, const FlatOptions& fo,
+                                         FlatSegmentation* out, const Adjacency& graph) {
   FeaturePressStats st;
-  if (!fo) {
-    st.press = press(s, curves, po);
-    if (out) {
-      *out = FlatSegmentation{};
-      out->region.assign(s.stick_count(), -1);
-    }
-    return st;
-  }
-  detail::Layout layout;  // one for every press of the surface
-  detail::make_layout(s, curves, layout);
-  Segmented g = segment(s, curves, layout, po, *fo, graph);
+  const Layout& layout = *run.layout;
+  Segmented& g = *run.estimates;
   FlatSegmentation& seg = g.seg;
   const PressStats& first_estimate = g.first;
   const StickSurface& est = g.est;
   const bool est_is_plain = g.plain;
   const PressOptions& eo = g.options;
-  apply_flats(s, seg);
   // Beyond the paper: the vertices near sharp flat/curved borders placed
   // by the curved side's fit (fit_creases), and those of creases between
   // two curved faces by both sides' fits (fit_curved_creases), then the rest pressed again
   // around them; the iterations are shared out so the cost is unchanged.
   // Each round re-presses a fifth of the iterations (fewer past 4 rounds, so
   // the first press keeps a share).
-  const bool creases = fo->passes.on(Pass::crease_fit) && seg.stats.junctions > 0;
+  const bool creases = fo.passes.on(Pass::crease_fit) && seg.stats.junctions > 0;
   const int rest = creases ? po.iterations / std::max(5, detail::kCreaseRounds + 1) : 0;
   PressOptions first = po;
   first.iterations = po.iterations - detail::kCreaseRounds * rest;
@@ -170,9 +179,9 @@ FeaturePressStats detail::press_with_flats(StickSurface& s, const SliceCurves& c
   }
   for (int round = 0; creases && round < detail::kCreaseRounds; ++round) {
     const auto t2 = std::chrono::steady_clock::now();
-    detail::CreaseRound cr{s, seg, *fo, graph, {}, seg.barrier, round + 1 == detail::kCreaseRounds};
+    detail::CreaseRound cr{s, seg, fo, graph, {}, seg.barrier, round + 1 == detail::kCreaseRounds};
     cr.barrier.resize(s.stick_count(), 0);
-    detail::FeatureContext fc{fo->passes, st.passes};
+    detail::FeatureContext fc{fo.passes, st.passes};
     fc.crease = &cr;
     detail::run_stage(Stage::crease_round, fc);
     seg.stats.seconds_creases += seconds_since(t2);
@@ -200,6 +209,22 @@ FeaturePressStats detail::press_with_flats(StickSurface& s, const SliceCurves& c
                 seg.flats.size());
   if (out) *out = std::move(seg);
   return st;
+}
+
+FeaturePressStats detail::press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,
+                                           const FlatOptions* fo, FlatSegmentation* out, const Adjacency& graph) {
+  if (!fo) {
+    FeaturePressStats st;
+    st.press = press(s, curves, po);
+    if (out) {
+      *out = FlatSegmentation{};
+      out->region.assign(s.stick_count(), -1);
+    }
+    return st;
+  }
+  FlatRun run;
+  find_flats_of(s, curves, po, *fo, graph, run);
+  return press_flat_run(s, run, po, *fo, out, graph);
 }
 
 namespace detail {

@@ -9,9 +9,45 @@
 #include "voxpress/core/error.h"
 #include "voxpress/labels/labels.h"
 #include "voxpress/labels/shared_press.h"
+#include "smooth/sequence.h"
 #include "voxpress/smooth/pipeline.h"
 
 namespace voxpress {
+
+namespace {
+
+// A label map's steps of the pipeline's sequence (smooth/sequence.h) on its
+// shared surface: each label's flats, the shared press (no crease rounds:
+// a shared vertex belongs to two labels' sides), each label's fit and
+// sharpening, one simplification.
+struct SharedSteps {
+  SharedLabels& r;
+  const LabelMasks& masks;
+  const LabelTable& table;
+  const SurfaceOptions& o;
+  PressOptions po;
+
+  void flats() {
+    FlatOptions fo = o.flat;
+    fo.passes = o.passes;
+    r.flats = find_shared_flats(masks, r.surface, table.labels, po, fo, o.progress);
+  }
+  void press() { r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr); }
+  void fit() {
+    QuadricFitOptions fit = o.fit;
+    fit.margin = po.margin;
+    r.fit = fit_shared_quadrics(r.surface, masks, table.labels, r.flats ? &*r.flats : nullptr, fit, o.passes);
+  }
+  void sharpen() {
+    SharpenOptions so = o.sharp;
+    so.passes = o.passes;
+    r.sharpen = sharpen_shared(r.surface, *r.flats, masks, table.labels, so);
+  }
+  void output(bool) {}  // the shared surface is the output, sharpened or not
+  void simplify() { r.simplify = simplify_shared(r.surface, o.simplify); }
+};
+
+}  // namespace
 
 SharedLabels press_shared_labels(const ScalarVolume& volume, const LabelTable& table, const SurfaceOptions& o) {
   require_float32_room(volume.lattice, o, volume.source);  // before the extraction's cost
@@ -41,25 +77,9 @@ SharedLabels press_shared_labels(SharedSurface surface, const LabelMasks& masks,
                                  std::to_string(cap >> 20) + " MiB");
   SharedLabels r;
   r.surface = std::move(surface);
-  PressOptions po = o.press;
-  o.overrides.apply(po);
-  if (o.passes.on(Pass::flats)) {
-    FlatOptions fo = o.flat;
-    fo.passes = o.passes;
-    r.flats = find_shared_flats(masks, r.surface, table.labels, po, fo, o.progress);
-  }
-  r.press = press_shared(r.surface, po, r.flats ? &*r.flats : nullptr);
-  {
-    QuadricFitOptions fit = o.fit;
-    fit.margin = po.margin;
-    r.fit = fit_shared_quadrics(r.surface, masks, table.labels, r.flats ? &*r.flats : nullptr, fit, o.passes);
-  }
-  if (r.flats && o.passes.on(Pass::sharpen)) {
-    SharpenOptions so = o.sharp;
-    so.passes = o.passes;
-    r.sharpen = sharpen_shared(r.surface, *r.flats, masks, table.labels, so);
-  }
-  if (o.simplify.faces || o.simplify.max_error) r.simplify = simplify_shared(r.surface, o.simplify);
+  SharedSteps steps{r, masks, table, o, o.press};
+  o.overrides.apply(steps.po);
+  detail::run_sequence(steps, o.passes, o.simplify.faces != 0 || o.simplify.max_error != 0);
   if (r.flats)
     for (const FlatSegmentation& seg : r.flats->segmentations) r.passes.add(seg.stats.passes);
   r.passes.add(r.fit.passes);

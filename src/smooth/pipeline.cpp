@@ -8,6 +8,7 @@
 #include "core/timing.h"
 #include "features/feature_context.h"
 #include "io/io_util.h"
+#include "smooth/sequence.h"
 
 namespace voxpress {
 
@@ -136,28 +137,59 @@ void require_float32_room(const Lattice& lattice, const SurfaceOptions& o, const
 
 namespace {
 
-// press_stick_surface's stages on sticks already on their own box, with
-// the surface's adjacency (built once for every stage of the run).
-void press_on_own_box(StickSurface& surface, const SurfaceOptions& o, SurfaceResult& r, const detail::Adjacency& graph) {
-  const PassSet& on = o.passes;
-  PressOptions po = o.press;
-  FlatOptions fo = o.flat;
-  fo.passes = on;
-  if (o.progress) po.progress = fo.progress = o.progress;
-  po.free_ends = po.free_ends && on.on(Pass::free_ends);
-  o.overrides.apply(po);
-  const bool features = on.on(Pass::flats);
-  const SliceCurves curves = build_slice_curves(surface);
-  const FeaturePressStats fs = detail::press_with_flats(surface, curves, po, features ? &fo : nullptr, &r.flats, graph);
-  r.press = fs.press;
-  r.pass_times = fs.passes;
-  detail::FitStage fit{surface, r.flats, graph, o.fit, {}};
-  fit.o.margin = po.margin;
-  detail::FeatureContext fc{on, r.pass_times};
-  fc.fit = &fit;
-  detail::run_stage(Stage::fit, fc);
-  r.fit = fit.out;
-}
+// A binary volume's steps of the pipeline's sequence (smooth/sequence.h),
+// on its sticks' own box, with the surface's adjacency built once for
+// every stage of the run.
+struct BinarySteps {
+  StickSurface& s;
+  const OwnBox& frame;
+  const SurfaceOptions& o;
+  SurfaceResult& r;
+  const detail::Adjacency graph;
+  PressOptions po;
+  FlatOptions fo;
+  SliceCurves curves;
+  detail::FlatRun run;
+
+  BinarySteps(StickSurface& own, const OwnBox& box, const SurfaceOptions& options, SurfaceResult& result)
+      : s(own), frame(box), o(options), r(result), graph(own.stick_count(), own.triangles), po(o.press), fo(o.flat) {
+    fo.passes = o.passes;
+    if (o.progress) po.progress = fo.progress = o.progress;
+    po.free_ends = po.free_ends && o.passes.on(Pass::free_ends);
+    o.overrides.apply(po);
+    curves = build_slice_curves(s);
+  }
+  void flats() { detail::find_flats_of(s, curves, po, fo, graph, run); }
+  void press() {
+    const FeaturePressStats fs = run.layout ? detail::press_flat_run(s, run, po, fo, &r.flats, graph)
+                                            : detail::press_with_flats(s, curves, po, nullptr, &r.flats, graph);
+    r.press = fs.press;
+    r.pass_times = fs.passes;
+  }
+  void fit() {
+    detail::FitStage fit{s, r.flats, graph, o.fit, {}};
+    fit.o.margin = po.margin;
+    detail::FeatureContext fc{o.passes, r.pass_times};
+    fc.fit = &fit;
+    detail::run_stage(Stage::fit, fc);
+    r.fit = fit.out;
+  }
+  void sharpen() {
+    SharpenOptions so = o.sharp;
+    so.colors = o.color_regions;
+    so.passes = o.passes;
+    SharpenResult sr = detail::sharpen(s, r.flats, so, graph);
+    r.mesh = std::move(sr.mesh);
+    r.sharpen = sr.stats;
+    r.pass_times.add(sr.stats.passes);
+  }
+  void output(bool sharpened) {
+    if (sharpened) return;
+    r.mesh = to_mesh(off_own_box(std::move(s), frame));  // written from the caller's lattice (s is not used after)
+    if (o.passes.on(Pass::flats)) add_region_attributes(r.mesh, r.flats, o.color_regions);
+  }
+  void simplify() { simplify_result(frame.lattice, o, r); }  // the caller's lattice, as Mesh::simplify has it
+};
 
 }  // namespace
 
@@ -167,7 +199,8 @@ void press_stick_surface(StickSurface& sticks, const SurfaceOptions& o, SurfaceR
   // sticks come back on their lattice (the chunked path's blocks too).
   OwnBox frame;
   StickSurface surface = on_own_box(std::move(sticks), &frame);
-  press_on_own_box(surface, o, r, detail::Adjacency(surface.stick_count(), surface.triangles));
+  BinarySteps steps(surface, frame, o, r);
+  detail::run_sequence(steps, o.passes, false, detail::Through::fit);
   sticks = off_own_box(std::move(surface), frame);
 }
 
@@ -192,26 +225,12 @@ SurfaceResult smooth_sticks(StickSurface surface, const SurfaceOptions& o, Surfa
   const Lattice lattice = surface.lattice;
   switch (o.method) {
     case Method::pressing: {
-      OwnBox frame;  // as press_stick_surface, the sharpening on the same box
+      OwnBox frame;  // as press_stick_surface
       StickSurface own = on_own_box(std::move(surface), &frame);
-      const detail::Adjacency graph(own.stick_count(), own.triangles);
-      press_on_own_box(own, o, r, graph);
-      const PassSet& on = o.passes;
-      const bool features = on.on(Pass::flats);
-      if (features && on.on(Pass::sharpen)) {
-        SharpenOptions so = o.sharp;
-        so.colors = o.color_regions;
-        so.passes = on;
-        SharpenResult sr = detail::sharpen(own, r.flats, so, graph);
-        r.mesh = std::move(sr.mesh);
-        r.sharpen = sr.stats;
-        r.pass_times.add(sr.stats.passes);
-      } else {
-        surface = off_own_box(std::move(own), frame);  // written from the caller's lattice
-        r.mesh = to_mesh(surface);
-        if (features) add_region_attributes(r.mesh, r.flats, o.color_regions);
-      }
-      break;
+      BinarySteps steps(own, frame, o, r);
+      detail::run_sequence(steps, o.passes, o.simplify.faces != 0 || o.simplify.max_error != 0);
+      r.seconds_smooth = seconds_since(t0) - r.simplify.seconds;
+      return r;
     }
     case Method::cesn: {
       SurfaceNetOptions so;

@@ -190,11 +190,16 @@ TEST(SharedLabels, EachLabelRunsThePassTable) {
   EXPECT_GT(on.passes.count[size_t(Pass::quadric_fit)], 0u);
   EXPECT_GE(times(on, Pass::flats), 2u) << "both boxes' detection";
   EXPECT_EQ(times(on, Pass::moves), on.sharpen.labels);
+  // The same sequence as a binary run: each stage's steps in table order,
+  // the stages in pipeline order (every label's detection, then every
+  // label's fit, then every label's sharpening).
+  test::expect_trace_follows_table(on.passes.trace, SurfaceOptions{}.passes);
   SurfaceOptions off;
   off.passes.disable(Pass::quadric_fit);
   const SharedLabels r = press_shared_labels(a.volume, table, off);
   EXPECT_EQ(times(r, Pass::quadric_fit), 0u);
   EXPECT_EQ(r.fit.moved, 0u);
+  test::expect_trace_follows_table(r.passes.trace, off.passes);
   for (uint32_t L = 1; L < r.surface.labels.size(); ++L)
     test::expect_guarantees(label_mesh(r.surface, L), test::whole_mask(a.volume, double(r.surface.labels[L])));
 }

@@ -144,31 +144,6 @@ TEST(Passes, TableIsInRunningOrderAndNamesRoundTrip) {
   EXPECT_EQ(s.disabled(), (std::vector<std::string>{"flats", "walls"}));
 }
 
-// The driver's trace, cut where the table index stops increasing, is a
-// sequence of stage runs; each must be exactly its stage's steps that
-// runs() allows, in table order, and the stages must come in pipeline
-// order (detection rounds, crease rounds, fit, sharpening).
-void expect_trace_follows_table(const std::vector<Pass>& trace, const PassSet& on) {
-  const auto& table = feature_passes();
-  std::vector<std::vector<Pass>> runs_of_stage;
-  for (size_t i = 0; i < trace.size(); ++i) {
-    if (i == 0 || size_t(trace[i]) <= size_t(trace[i - 1]) || table[size_t(trace[i])].stage != table[size_t(trace[i - 1])].stage)
-      runs_of_stage.emplace_back();
-    runs_of_stage.back().push_back(trace[i]);
-  }
-  ASSERT_FALSE(runs_of_stage.empty());
-  Stage last = Stage::detect;
-  for (const std::vector<Pass>& r : runs_of_stage) {
-    const Stage stage = table[size_t(r.front())].stage;
-    EXPECT_GE(stage, last);
-    last = stage;
-    std::vector<Pass> expected;
-    for (const PassInfo& p : table)
-      if (p.stage == stage && p.run && runs(p, on)) expected.push_back(p.pass);
-    EXPECT_EQ(r, expected) << "stage " << int(stage);
-  }
-}
-
 TEST(Passes, TheDriverRunsEachStageInTableOrder) {
   // A rotated CAD part has flats, junctions (crease rounds) and creases:
   // every stage runs. Switched-off passes leave the trace, and a pass whose
@@ -183,7 +158,7 @@ TEST(Passes, TheDriverRunsEachStageInTableOrder) {
     if (*off) o.passes.disable(off);
     const SurfaceResult r = smooth_surface(part.volume, o);
     const std::vector<Pass>& trace = r.pass_times.trace;
-    expect_trace_follows_table(trace, o.passes);
+    test::expect_trace_follows_table(trace, o.passes);
     for (Stage st : {Stage::detect, Stage::crease_round, Stage::fit, Stage::sharpen}) {
       if (st == Stage::crease_round && !o.passes.on(Pass::junctions)) continue;  // no junction, no crease round
       EXPECT_TRUE(std::any_of(trace.begin(), trace.end(), [&](Pass p) { return feature_passes()[size_t(p)].stage == st; }))
