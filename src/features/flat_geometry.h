@@ -233,12 +233,14 @@ inline double cutting_radius(double u, double v, double c, double cap) {
 constexpr double kRoundCap = 16;  // cells: no sample bounds the rounding at all (leaning planes, not a fillet)
 struct RoundingEvidence {
   double allow = kRoundCap;
-  bool demanded = false;
+  double need = kRoundCap;  // the smallest rounding that cuts off a demanding sample
   void add(const Plane& a, const Plane& b, int kind, const Vec3& inside, const Vec3& outside) {
     const Vec3& keep = kind > 0 ? inside : outside;
     const Vec3& gone = kind > 0 ? outside : inside;
-    allow = std::min(allow, cutting_radius(-kind * (a.n.dot(keep) - a.c), -kind * (b.n.dot(keep) - b.c), a.n.dot(b.n), kRoundCap));
-    demanded |= std::min(-kind * (a.n.dot(gone) - a.c), -kind * (b.n.dot(gone) - b.c)) > kRoundEvidence;
+    const double c = a.n.dot(b.n);
+    allow = std::min(allow, cutting_radius(-kind * (a.n.dot(keep) - a.c), -kind * (b.n.dot(keep) - b.c), c, kRoundCap));
+    const double u = -kind * (a.n.dot(gone) - a.c), v = -kind * (b.n.dot(gone) - b.c);
+    if (std::min(u, v) > kRoundEvidence) need = std::min(need, cutting_radius(u, v, c, kRoundCap));
   }
   // The sticks of the vertices `vs` and of their 1-rings (adjacency off,
   // adj), with each stick's inside and outside samples.
@@ -251,8 +253,15 @@ struct RoundingEvidence {
         add(a, b, kind, inside(w), outside(w));
       }
   }
-  // Round: the samples allow at least `radius` and demand a rounding, and some sample bounds it.
-  bool round(double radius) const { return demanded && allow >= radius && allow < kRoundCap; }
+  // Round: the samples allow at least `radius` and demand a rounding, and
+  // some sample bounds it.
+  bool round(double radius) const { return need < kRoundCap && allow >= radius && allow < kRoundCap; }
+  // Round, on one pair of planes: also, a rounding the samples allow cuts
+  // off a demanding sample (one deep inside both planes that no allowed
+  // fillet reaches is cut off by something else, a third face at a corner).
+  // A sharpening chain's vertices each bring their own planes, so there
+  // only round() is asked.
+  bool round_between(double radius) const { return round(radius) && need <= allow; }
   // Sharp: some sample forbids a rounding of `radius` (whether or not one is demanded).
   bool forbids(double radius) const { return allow < radius; }
 };

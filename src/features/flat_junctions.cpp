@@ -153,7 +153,11 @@ bool is_junction(FlatsContext& ctx, size_t v, int32_t f0, detail::RingScratch& r
 // round-chains judges the sharpening's chains: at a convex edge no inside
 // sample of the chain's sticks and their 1-rings may lie outside the
 // fillet, at a concave one no outside sample), and must demand a rounding
-// (a sample of the other kind kRoundEvidence inside both planes). A chain
+// they allow (a sample of the other kind kRoundEvidence inside both planes
+// that such a fillet cuts off; near a corner a third face cuts off samples
+// no fillet of the two planes reaches: releasing those short chains had
+// left the CAD part's sharp edges unlabelled at their ends, RoundingEvidence::
+// round_between, `build/bench/bench_compare --quick --only pressing`). A chain
 // allowing kRoundBorderRadius or more is a resolved fillet: its vertices
 // are no junctions, so the extension does not freeze the fillet's start
 // onto a flat's plane (at r = 2-3 cells that flattening was most of the
@@ -195,7 +199,7 @@ size_t round_borders(FlatsContext& ctx) {
     detail::RoundingEvidence evidence;
     evidence.add_rings(A, B, kind, chain, S.adj_off, S.adj, [&](uint32_t w) { return S.inside(w); },
                        [&](uint32_t w) { return S.outside(w); });
-    if (!evidence.round(detail::kRoundBorderRadius)) continue;
+    if (!evidence.round_between(detail::kRoundBorderRadius)) continue;
     for (uint32_t v : chain) seg.junction[v] = 0;
     released += chain.size();
   }
