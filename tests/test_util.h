@@ -161,31 +161,35 @@ struct CliRun {
 /// limit (RLIMIT_AS, bytes; 0 = none), so that a regression fails the test
 /// instead of exhausting the machine.
 CliRun run_cli_measured(const std::string& args, uint64_t address_space_limit = 0);
-/// Issue 75's family: the box at `res`, rotation random:seed, its edges and
-/// corners rounded by `fillet` cells (0: sharp), with its exact truth.
-struct FilletedBox {
+/// A generated shape at `res`, rotation random:seed, with its exact truth;
+/// the box's edges and corners rounded by `fillet` cells (issue 75's
+/// family; 0: sharp).
+struct ShapeAndTruth {
   GeneratedShape shape;
   std::unique_ptr<Truth> truth;
 };
-inline FilletedBox filleted_box(int64_t res, int seed, double fillet) {
+inline ShapeAndTruth shape_and_truth(ShapeKind kind, int64_t res, int seed, double fillet = 0) {
   GenerateOptions o;
   o.res = res;
   o.rotation = parse_rotation("random:" + std::to_string(seed));
   o.fillet = fillet;
-  FilletedBox b{generate_shape(ShapeKind::box, o), nullptr};
-  b.truth = shape_truth(ShapeKind::box, b.shape.linear, b.shape.translation, b.shape.fillet);
+  ShapeAndTruth b{generate_shape(kind, o), nullptr};
+  b.truth = shape_truth(kind, b.shape.linear, b.shape.translation, b.shape.fillet);
   return b;
 }
-/// A rule of the feature layer on (every pass) and off, on
-/// filleted_box(res, seed, fillet): both results and the rule's count with
-/// it on; the default's guarantees are checked.
+inline ShapeAndTruth filleted_box(int64_t res, int seed, double fillet) {
+  return shape_and_truth(ShapeKind::box, res, seed, fillet);
+}
+/// A rule of the feature layer on (every pass) and off, on `shape`: both
+/// results and the rule's count with it on; the default's guarantees are
+/// checked.
 struct RuleOnOff {
-  FilletedBox box;
+  ShapeAndTruth box;
   SurfaceResult on, off;
   size_t count = 0;
 };
-inline RuleOnOff fillet_rule_on_off(int64_t res, int seed, double fillet, Pass rule) {
-  RuleOnOff r{filleted_box(res, seed, fillet), {}, {}, 0};
+inline RuleOnOff rule_on_off(ShapeAndTruth shape, Pass rule) {
+  RuleOnOff r{std::move(shape), {}, {}, 0};
   SurfaceOptions off;
   off.passes.disable(rule);
   r.on = smooth_surface(r.box.shape.volume);
@@ -193,6 +197,9 @@ inline RuleOnOff fillet_rule_on_off(int64_t res, int seed, double fillet, Pass r
   expect_guarantees(r.on.mesh, r.box.shape.volume);
   r.count = r.on.pass_times.count[size_t(rule)];
   return r;
+}
+inline RuleOnOff fillet_rule_on_off(int64_t res, int seed, double fillet, Pass rule) {
+  return rule_on_off(filleted_box(res, seed, fillet), rule);
 }
 /// Lines in a command's output (one error = one line).
 inline size_t count_lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }

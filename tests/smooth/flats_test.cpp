@@ -319,19 +319,13 @@ TEST(Flats, SharpEdgesEndingAtAFilletStayJunctions) {
   // cost 1.9-2.0 points at these rotations).
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    GenerateOptions g;
-    g.res = 64;
-    g.rotation = parse_rotation("random:" + std::to_string(seed));
-    const GeneratedShape part = generate_shape(ShapeKind::cad_part, g);
-    const auto truth = shape_truth(ShapeKind::cad_part, part.linear, part.translation);
+    const test::RuleOnOff t = test::rule_on_off(test::shape_and_truth(ShapeKind::cad_part, 64, seed), Pass::round_borders);
     EvalOptions eo;
-    eo.volume = &part.volume;
+    eo.volume = &t.box.shape.volume;
     eo.samples = 20000;
     eo.self_intersections = false;
-    SurfaceOptions on, off;
-    off.passes.disable(Pass::round_borders);
-    const EvalReport a = evaluate(smooth_surface(part.volume, on).mesh, *truth, eo);
-    const EvalReport b = evaluate(smooth_surface(part.volume, off).mesh, *truth, eo);
+    const EvalReport a = evaluate(t.on.mesh, *t.box.truth, eo);
+    const EvalReport b = evaluate(t.off.mesh, *t.box.truth, eo);
     ASSERT_TRUE(a.sharp_recall && b.sharp_recall);
     EXPECT_GT(*a.sharp_recall, *b.sharp_recall - 0.015);
   }

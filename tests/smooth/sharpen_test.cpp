@@ -443,7 +443,7 @@ TEST(Sharpen, FilletsTheLatticeResolvesStayRound) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     size_t sharp_labels = 0;
     for (double r : {0.0, 1.5}) {
-      const test::FilletedBox box = test::filleted_box(48, seed, r);
+      const test::ShapeAndTruth box = test::filleted_box(48, seed, r);
       const GeneratedShape& g = box.shape;
       const auto& truth = box.truth;
       SurfaceOptions plain;
