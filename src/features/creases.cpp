@@ -4,6 +4,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <limits>
 
@@ -117,19 +118,28 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
   for (size_t v = 0; v < n; ++v)
     if (band[v]) members.push_back(uint32_t(v));
   std::vector<CurvedCrease> found(members.size(), CurvedCrease{0, std::numeric_limits<double>::quiet_NaN(), {}, {}});
-  tbb::enumerable_thread_specific<RingScratch> scratch;
-  detail::parallel_ranges(members.size(), 64, [&](detail::IndexRange r) {
-    RingScratch& rs = scratch.local();
+  struct Work {  // one thread's scratch
+    RingScratch rs;
     std::vector<uint32_t> P;
     std::vector<uint8_t> side, keep;
     std::vector<Vec3> pa, pb, ia, xa, ib, xb;
-    for (size_t i = r.begin(); i < r.end(); ++i) {
+  };
+  tbb::enumerable_thread_specific<Work> scratch;
+  // found[i]: the crease through members[i], if its two sides' quadrics
+  // meet at one (t NaN otherwise).
+  const auto fit_member = [&](size_t i) {
+    Work& wk = scratch.local();
+    RingScratch& rs = wk.rs;
+    std::vector<uint32_t>& P = wk.P;
+    std::vector<uint8_t>&side = wk.side, &keep = wk.keep;
+    std::vector<Vec3>&pa = wk.pa, &pb = wk.pb, &ia = wk.ia, &xa = wk.xa, &ib = wk.ib, &xb = wk.xb;
+    {
       const uint32_t v = members[i];
       rings_around(v, c.rings, off, adj, [&](uint32_t w) { return region[w] < 0; }, rs);
       P.clear();
       for (const auto& [w, d] : rs.out)
         if (!band[w] && role[w] != kCreaseSkip) P.push_back(w);
-      if (P.size() < 2 * kSidePoints) continue;
+      if (P.size() < 2 * kSidePoints) return;
       // Two sides: 2-means on the normals, seeded by the normal farthest
       // from v's and the one farthest from that.
       uint32_t a = P[0], b = P[0];
@@ -149,7 +159,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
         ma = sa.normalized();
         mb = sb.normalized();
       }
-      if (degrees_between(ma, mb) < c.sharp_angle) continue;
+      if (degrees_between(ma, mb) < c.sharp_angle) return;
       // Each side's points (kept ones), their sticks' samples and the
       // side's outward direction (the sum of its sticks' inside -> outside
       // directions).
@@ -170,7 +180,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
         return pa.size() >= kSidePoints && pb.size() >= kSidePoints;
       };
       Quadric QA, QB;
-      if (!split() || !QA.fit(pa, oa) || !QB.fit(pb, ob)) continue;
+      if (!split() || !QA.fit(pa, oa) || !QB.fit(pb, ob)) return;
       // Trimming: each point goes to the nearer quadric, and points farther
       // than `trim` from both (the rounded crease the band threshold left
       // in) are dropped; then both are refitted.
@@ -184,7 +194,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
         }
         fitted = split() && QA.fit(pa, oa) && QB.fit(pb, ob);
       }
-      if (!fitted || QA.residual > c.residual || QB.residual > c.residual) continue;
+      if (!fitted || QA.residual > c.residual || QB.residual > c.residual) return;
       Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
       for (const Vec3& p : pa) ca += p;
       for (const Vec3& p : pb) cb += p;
@@ -193,20 +203,20 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       QA.stab(pa, ia, xa, c.stab_eps, c.stab_weight, kStabSolves);
       QB.stab(pb, ib, xb, c.stab_eps, c.stab_weight, kStabSolves);
       const double ga = QA.n.dot(cb - QA.foot(cb)), gb = QB.n.dot(ca - QB.foot(ca));
-      if ((ga < 0) != (gb < 0)) continue;
+      if ((ga < 0) != (gb < 0)) return;
       const bool convex = ga < 0;
       const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
       const double tv = (x[v] - in).dot(out - in);
       // Where the stick leaves each side's solid.
       const double ta = leave(QA, in, out, tv), tb = leave(QB, in, out, tv);
-      if (std::isnan(ta) || std::isnan(tb)) continue;
+      if (std::isnan(ta) || std::isnan(tb)) return;
       const double t = std::clamp(convex ? std::min(ta, tb) : std::max(ta, tb), c.margin, 1 - c.margin);
-      if (std::abs(t - tv) > c.max_move) continue;
+      if (std::abs(t - tv) > c.max_move) return;
       const bool a_side = convex ? ta <= tb : ta >= tb;
       const Vec3 q = in + t * (out - in);
       const Quadric& C = a_side ? QA : QB;
       const Quadric& O = a_side ? QB : QA;
-      if (std::abs(O.n.dot(q - O.foot(q))) > c.other_distance) continue;  // no crease here
+      if (std::abs(O.n.dot(q - O.foot(q))) > c.other_distance) return;  // no crease here
       CurvedCrease& f = found[i];
       f.v = v;
       f.t = t;
@@ -219,7 +229,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       if (degrees_between((Minv_t * f.chosen.n).normalized(), (Minv_t * f.other.n).normalized()) < c.sharp_angle)
         f.t = std::numeric_limits<double>::quiet_NaN();
     }
-  });
+  };
   // Evidence: a crease between two curved faces is kept only where it
   // continues a proven crease. Locally it proves nothing: at 128^3 a tight
   // fold of an organic solid (a bunny's neck, a heart's grooves) fits two
@@ -232,38 +242,67 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
   // zone, a thin wall) lies within the side fit's c.rings rings (closer in,
   // the fit has too few side points to find the crease), and the chain
   // goes on through found vertices at most kChainGap rings apart.
-  std::vector<uint8_t> is_found(n, 0), reached(n, 0);
-  for (const auto& f : found)
-    if (!std::isnan(f.t)) is_found[f.v] = 1;
-  std::vector<uint32_t> chain;
-  RingScratch rs;
-  for (const auto& f : found) {
-    if (std::isnan(f.t) || !c.network) continue;
-    rings_around(f.v, c.rings, off, adj, [](uint32_t) { return true; }, rs);
-    if (std::any_of(rs.out.begin(), rs.out.end(),
-                    [&](const auto& wd) { return role[wd.first] != kCreaseFree && region[wd.first] < 0; })) {
-      reached[f.v] = 1;
-      chain.push_back(f.v);
+  // The search follows that rule (beyond the paper's cost: on organs most
+  // band vertices are far from any proven feature, and their fits were
+  // most of the label map's sharpening, `final-curved-creases`): members
+  // within c.rings of a proven feature are fitted first; each one found
+  // seeds the chain, and the members within kChainGap rings of a chained
+  // one are fitted next, wave by wave. A member no wave reaches could only
+  // have been dropped, so it is never fitted. The kept creases are those of
+  // fitting every member and chaining (each member's fit depends on the
+  // inputs only).
+  std::vector<uint8_t> fitted(members.size(), 0);
+  std::vector<uint32_t> wave;
+  if (!c.network) {
+    wave.resize(members.size());
+    std::iota(wave.begin(), wave.end(), 0u);
+  } else {
+    // Within c.rings rings of a proven feature: one search from all of them.
+    std::vector<uint8_t> depth(n, UINT8_MAX);
+    std::vector<uint32_t> front, ahead;
+    for (uint32_t v = 0; v < n; ++v)
+      if (role[v] != kCreaseFree && region[v] < 0) depth[v] = 0, front.push_back(v);
+    for (uint32_t d = 1; d <= c.rings && !front.empty(); ++d) {
+      ahead.clear();
+      for (uint32_t u : front)
+        for (uint32_t k = off[u]; k < off[u + 1]; ++k)
+          if (depth[adj[k]] == UINT8_MAX) depth[adj[k]] = uint8_t(d), ahead.push_back(adj[k]);
+      front.swap(ahead);
     }
+    for (uint32_t i = 0; i < members.size(); ++i)
+      if (depth[members[i]] != UINT8_MAX) wave.push_back(i);
   }
-  while (!chain.empty()) {
-    const uint32_t u = chain.back();
-    chain.pop_back();
-    rings_around(u, kChainGap, off, adj, [](uint32_t) { return true; }, rs);
-    for (const auto& [w, d] : rs.out)
-      if (is_found[w] && !reached[w]) {
-        reached[w] = 1;
-        chain.push_back(w);
-      }
+  std::vector<int32_t> member_of(c.network ? n : 0, -1);
+  if (c.network)
+    for (uint32_t i = 0; i < members.size(); ++i) member_of[members[i]] = int32_t(i);
+  RingScratch rs;
+  while (!wave.empty()) {
+    for (uint32_t i : wave) fitted[i] = 1;
+    detail::parallel_ranges(wave.size(), 16, [&](detail::IndexRange r) {
+      for (size_t k = r.begin(); k < r.end(); ++k) fit_member(wave[k]);
+    });
+    if (!c.network) break;
+    // The next wave: unfitted members within kChainGap rings of a found one.
+    std::vector<uint32_t> next;
+    for (uint32_t i : wave) {
+      if (std::isnan(found[i].t)) continue;
+      rings_around(members[i], kChainGap, off, adj, [](uint32_t) { return true; }, rs);
+      for (const auto& [w, d] : rs.out)
+        if (const int32_t j = member_of[w]; j >= 0 && !fitted[size_t(j)]) {
+          fitted[size_t(j)] = 1;
+          next.push_back(uint32_t(j));
+        }
+    }
+    std::sort(next.begin(), next.end());
+    wave.swap(next);
   }
   std::vector<CurvedCrease> out;
   if (unproven) *unproven = 0;
-  for (const auto& f : found) {
-    if (std::isnan(f.t)) continue;
-    if (reached[f.v] || !c.network) {
-      out.push_back(f);
-    } else if (unproven) {
-      ++*unproven;
+  for (size_t i = 0; i < members.size(); ++i) {
+    if (!std::isnan(found[i].t)) {
+      out.push_back(found[i]);
+    } else if (unproven && !fitted[i]) {
+      ++*unproven;  // a band vertex no proven crease reaches
     }
   }
   if (normals) *normals = std::move(vn);
