@@ -94,19 +94,21 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
   return targets;
 }
 
-std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
-                                                const std::vector<uint8_t>& role, const std::vector<Vec3>& x,
-                                                const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
-                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals, size_t* unproven) {
+// Vertex normals vn (physical) of the surface at x, and the band: the free
+// curved vertices whose normal turns by c.band_angle or more to a curved
+// neighbour (band flags and their list, `members`).
+void band_of(const StickSurface& sticks, const std::vector<int32_t>& region, const std::vector<uint8_t>& role,
+             const std::vector<Vec3>& x, const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
+             const CurvedCreaseFit& c, const Mat3& Minv_t, std::vector<Vec3>& vn, std::vector<uint8_t>& band,
+             std::vector<uint32_t>& members) {
   const size_t n = region.size();
-  const Mat3 Minv_t = sticks.lattice.index_to_physical_matrix().inverse().transpose();
-  std::vector<Vec3> vn(n, Vec3::Zero());
+  vn.assign(n, Vec3::Zero());
   for (const Triangle& t : sticks.triangles) {
     const Vec3 fn = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
     for (uint32_t v : t) vn[v] += fn;
   }
   for (auto& v : vn) v = (Minv_t * v).normalized();
-  std::vector<uint8_t> band(n, 0);
+  band.assign(n, 0);
   for (size_t v = 0; v < n; ++v) {
     if (region[v] >= 0 || role[v] != kCreaseFree) continue;
     double mx = 0;
@@ -114,9 +116,83 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
       if (region[adj[k]] < 0) mx = std::max(mx, degrees_between(vn[v], vn[adj[k]]));
     band[v] = mx >= c.band_angle;
   }
-  std::vector<uint32_t> members;
+  members.clear();
   for (size_t v = 0; v < n; ++v)
     if (band[v]) members.push_back(uint32_t(v));
+}
+
+// The crease network's search (curved_crease_targets): fit(i) for the
+// members within c.rings rings of a proven feature, then, wave by wave, for
+// the unfitted members within kChainGap rings of one found (found[i].t not
+// NaN); without the network, for every member. Returns which were fitted.
+// A member no wave reaches could only have been dropped, so the kept
+// creases are those of fitting every member, then chaining (each fit
+// depends on the inputs only). On organs most band vertices are far from
+// any proven feature: their fits were most of a label map's sharpening
+// (`final-curved-creases`, docs/BENCHMARKS.md, Speed of press).
+template <class Fit>
+std::vector<uint8_t> fit_in_waves(const std::vector<uint32_t>& members, const std::vector<int32_t>& region,
+                                  const std::vector<uint8_t>& role, const std::vector<uint32_t>& off,
+                                  const std::vector<uint32_t>& adj, const CurvedCreaseFit& c,
+                                  const std::vector<CurvedCrease>& found, Fit&& fit) {
+  const size_t n = region.size();
+  std::vector<uint8_t> fitted(members.size(), 0);
+  std::vector<uint32_t> wave;
+  if (!c.network) {
+    wave.resize(members.size());
+    std::iota(wave.begin(), wave.end(), 0u);
+  } else {
+    // Within c.rings rings of a proven feature: one search from all of them.
+    std::vector<uint8_t> depth(n, UINT8_MAX);
+    std::vector<uint32_t> front, ahead;
+    for (uint32_t v = 0; v < n; ++v)
+      if (role[v] != kCreaseFree && region[v] < 0) depth[v] = 0, front.push_back(v);
+    for (uint32_t d = 1; d <= c.rings && !front.empty(); ++d) {
+      ahead.clear();
+      for (uint32_t u : front)
+        for (uint32_t k = off[u]; k < off[u + 1]; ++k)
+          if (depth[adj[k]] == UINT8_MAX) depth[adj[k]] = uint8_t(d), ahead.push_back(adj[k]);
+      front.swap(ahead);
+    }
+    for (uint32_t i = 0; i < members.size(); ++i)
+      if (depth[members[i]] != UINT8_MAX) wave.push_back(i);
+  }
+  std::vector<int32_t> member_of(c.network ? n : 0, -1);
+  if (c.network)
+    for (uint32_t i = 0; i < members.size(); ++i) member_of[members[i]] = int32_t(i);
+  RingScratch rs;
+  while (!wave.empty()) {
+    for (uint32_t i : wave) fitted[i] = 1;
+    detail::parallel_ranges(wave.size(), 16, [&](detail::IndexRange r) {
+      for (size_t k = r.begin(); k < r.end(); ++k) fit(wave[k]);
+    });
+    if (!c.network) break;
+    // The next wave: unfitted members within kChainGap rings of a found one.
+    std::vector<uint32_t> next;
+    for (uint32_t i : wave) {
+      if (std::isnan(found[i].t)) continue;
+      rings_around(members[i], kChainGap, off, adj, [](uint32_t) { return true; }, rs);
+      for (const auto& [w, d] : rs.out)
+        if (const int32_t j = member_of[w]; j >= 0 && !fitted[size_t(j)]) {
+          fitted[size_t(j)] = 1;
+          next.push_back(uint32_t(j));
+        }
+    }
+    std::sort(next.begin(), next.end());
+    wave.swap(next);
+  }
+  return fitted;
+}
+
+std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, const std::vector<int32_t>& region,
+                                                const std::vector<uint8_t>& role, const std::vector<Vec3>& x,
+                                                const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj,
+                                                const CurvedCreaseFit& c, std::vector<Vec3>* normals, size_t* unproven) {
+  const Mat3 Minv_t = sticks.lattice.index_to_physical_matrix().inverse().transpose();
+  std::vector<Vec3> vn;
+  std::vector<uint8_t> band;
+  std::vector<uint32_t> members;
+  band_of(sticks, region, role, x, off, adj, c, Minv_t, vn, band, members);
   std::vector<CurvedCrease> found(members.size(), CurvedCrease{0, std::numeric_limits<double>::quiet_NaN(), {}, {}});
   struct Work {  // one thread's scratch
     RingScratch rs;
@@ -242,60 +318,9 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
   // zone, a thin wall) lies within the side fit's c.rings rings (closer in,
   // the fit has too few side points to find the crease), and the chain
   // goes on through found vertices at most kChainGap rings apart.
-  // The search follows that rule (beyond the paper's cost: on organs most
-  // band vertices are far from any proven feature, and their fits were
-  // most of the label map's sharpening, `final-curved-creases`): members
-  // within c.rings of a proven feature are fitted first; each one found
-  // seeds the chain, and the members within kChainGap rings of a chained
-  // one are fitted next, wave by wave. A member no wave reaches could only
-  // have been dropped, so it is never fitted. The kept creases are those of
-  // fitting every member and chaining (each member's fit depends on the
-  // inputs only).
-  std::vector<uint8_t> fitted(members.size(), 0);
-  std::vector<uint32_t> wave;
-  if (!c.network) {
-    wave.resize(members.size());
-    std::iota(wave.begin(), wave.end(), 0u);
-  } else {
-    // Within c.rings rings of a proven feature: one search from all of them.
-    std::vector<uint8_t> depth(n, UINT8_MAX);
-    std::vector<uint32_t> front, ahead;
-    for (uint32_t v = 0; v < n; ++v)
-      if (role[v] != kCreaseFree && region[v] < 0) depth[v] = 0, front.push_back(v);
-    for (uint32_t d = 1; d <= c.rings && !front.empty(); ++d) {
-      ahead.clear();
-      for (uint32_t u : front)
-        for (uint32_t k = off[u]; k < off[u + 1]; ++k)
-          if (depth[adj[k]] == UINT8_MAX) depth[adj[k]] = uint8_t(d), ahead.push_back(adj[k]);
-      front.swap(ahead);
-    }
-    for (uint32_t i = 0; i < members.size(); ++i)
-      if (depth[members[i]] != UINT8_MAX) wave.push_back(i);
-  }
-  std::vector<int32_t> member_of(c.network ? n : 0, -1);
-  if (c.network)
-    for (uint32_t i = 0; i < members.size(); ++i) member_of[members[i]] = int32_t(i);
-  RingScratch rs;
-  while (!wave.empty()) {
-    for (uint32_t i : wave) fitted[i] = 1;
-    detail::parallel_ranges(wave.size(), 16, [&](detail::IndexRange r) {
-      for (size_t k = r.begin(); k < r.end(); ++k) fit_member(wave[k]);
-    });
-    if (!c.network) break;
-    // The next wave: unfitted members within kChainGap rings of a found one.
-    std::vector<uint32_t> next;
-    for (uint32_t i : wave) {
-      if (std::isnan(found[i].t)) continue;
-      rings_around(members[i], kChainGap, off, adj, [](uint32_t) { return true; }, rs);
-      for (const auto& [w, d] : rs.out)
-        if (const int32_t j = member_of[w]; j >= 0 && !fitted[size_t(j)]) {
-          fitted[size_t(j)] = 1;
-          next.push_back(uint32_t(j));
-        }
-    }
-    std::sort(next.begin(), next.end());
-    wave.swap(next);
-  }
+  // The search follows that rule (fit_in_waves).
+  const std::vector<uint8_t> fitted =
+      fit_in_waves(members, region, role, off, adj, c, found, [&](size_t i) { fit_member(i); });
   std::vector<CurvedCrease> out;
   if (unproven) *unproven = 0;
   for (size_t i = 0; i < members.size(); ++i) {
