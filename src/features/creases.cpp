@@ -209,102 +209,100 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
     std::vector<uint32_t>& P = wk.P;
     std::vector<uint8_t>&side = wk.side, &keep = wk.keep;
     std::vector<Vec3>&pa = wk.pa, &pb = wk.pb, &ia = wk.ia, &xa = wk.xa, &ib = wk.ib, &xb = wk.xb;
-    {
-      const uint32_t v = members[i];
-      rings_around(v, c.rings, off, adj, [&](uint32_t w) { return region[w] < 0; }, rs);
-      P.clear();
-      for (const auto& [w, d] : rs.out)
-        if (!band[w] && role[w] != kCreaseSkip) P.push_back(w);
-      if (P.size() < 2 * kSidePoints) return;
-      // Two sides: 2-means on the normals, seeded by the normal farthest
-      // from v's and the one farthest from that.
-      uint32_t a = P[0], b = P[0];
-      for (uint32_t w : P)
-        if (vn[w].dot(vn[v]) < vn[a].dot(vn[v])) a = w;
-      for (uint32_t w : P)
-        if (vn[w].dot(vn[a]) < vn[b].dot(vn[a])) b = w;
-      Vec3 ma = vn[a], mb = vn[b];
-      side.assign(P.size(), 0);
-      for (int it = 0; it < 4; ++it) {
-        Vec3 sa = Vec3::Zero(), sb = Vec3::Zero();
-        for (size_t k = 0; k < P.size(); ++k) {
-          side[k] = vn[P[k]].dot(ma) < vn[P[k]].dot(mb);
-          (side[k] ? sb : sa) += vn[P[k]];
-        }
-        if (sa.isZero() || sb.isZero()) break;
-        ma = sa.normalized();
-        mb = sb.normalized();
+    const uint32_t v = members[i];
+    rings_around(v, c.rings, off, adj, [&](uint32_t w) { return region[w] < 0; }, rs);
+    P.clear();
+    for (const auto& [w, d] : rs.out)
+      if (!band[w] && role[w] != kCreaseSkip) P.push_back(w);
+    if (P.size() < 2 * kSidePoints) return;
+    // Two sides: 2-means on the normals, seeded by the normal farthest
+    // from v's and the one farthest from that.
+    uint32_t a = P[0], b = P[0];
+    for (uint32_t w : P)
+      if (vn[w].dot(vn[v]) < vn[a].dot(vn[v])) a = w;
+    for (uint32_t w : P)
+      if (vn[w].dot(vn[a]) < vn[b].dot(vn[a])) b = w;
+    Vec3 ma = vn[a], mb = vn[b];
+    side.assign(P.size(), 0);
+    for (int it = 0; it < 4; ++it) {
+      Vec3 sa = Vec3::Zero(), sb = Vec3::Zero();
+      for (size_t k = 0; k < P.size(); ++k) {
+        side[k] = vn[P[k]].dot(ma) < vn[P[k]].dot(mb);
+        (side[k] ? sb : sa) += vn[P[k]];
       }
-      if (degrees_between(ma, mb) < c.sharp_angle) return;
-      // Each side's points (kept ones), their sticks' samples and the
-      // side's outward direction (the sum of its sticks' inside -> outside
-      // directions).
-      keep.assign(P.size(), 1);
-      Vec3 oa, ob;
-      auto split = [&] {
-        for (auto* list : {&pa, &pb, &ia, &xa, &ib, &xb}) list->clear();
-        oa.setZero();
-        ob.setZero();
-        for (size_t k = 0; k < P.size(); ++k) {
-          if (!keep[k]) continue;
-          const Vec3 in = sticks.inside_sample(P[k]), out = sticks.outside_sample(P[k]);
-          (side[k] ? pb : pa).push_back(x[P[k]]);
-          (side[k] ? ib : ia).push_back(in);
-          (side[k] ? xb : xa).push_back(out);
-          (side[k] ? ob : oa) += out - in;
-        }
-        return pa.size() >= kSidePoints && pb.size() >= kSidePoints;
-      };
-      Quadric QA, QB;
-      if (!split() || !QA.fit(pa, oa) || !QB.fit(pb, ob)) return;
-      // Trimming: each point goes to the nearer quadric, and points farther
-      // than `trim` from both (the rounded crease the band threshold left
-      // in) are dropped; then both are refitted.
-      bool fitted = true;
-      for (uint32_t round = 0; round < c.trim_rounds && fitted; ++round) {
-        for (size_t k = 0; k < P.size(); ++k) {
-          const Vec3& p = x[P[k]];
-          const double da = std::abs(QA.n.dot(p - QA.foot(p))), db = std::abs(QB.n.dot(p - QB.foot(p)));
-          side[k] = db < da;
-          keep[k] = std::min(da, db) <= c.trim;
-        }
-        fitted = split() && QA.fit(pa, oa) && QB.fit(pb, ob);
-      }
-      if (!fitted || QA.residual > c.residual || QB.residual > c.residual) return;
-      Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
-      for (const Vec3& p : pa) ca += p;
-      for (const Vec3& p : pb) cb += p;
-      ca /= double(pa.size());
-      cb /= double(pb.size());
-      QA.stab(pa, ia, xa, c.stab_eps, c.stab_weight, kStabSolves);
-      QB.stab(pb, ib, xb, c.stab_eps, c.stab_weight, kStabSolves);
-      const double ga = QA.n.dot(cb - QA.foot(cb)), gb = QB.n.dot(ca - QB.foot(ca));
-      if ((ga < 0) != (gb < 0)) return;
-      const bool convex = ga < 0;
-      const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
-      const double tv = (x[v] - in).dot(out - in);
-      // Where the stick leaves each side's solid.
-      const double ta = leave(QA, in, out, tv), tb = leave(QB, in, out, tv);
-      if (std::isnan(ta) || std::isnan(tb)) return;
-      const double t = std::clamp(convex ? std::min(ta, tb) : std::max(ta, tb), c.margin, 1 - c.margin);
-      if (std::abs(t - tv) > c.max_move) return;
-      const bool a_side = convex ? ta <= tb : ta >= tb;
-      const Vec3 q = in + t * (out - in);
-      const Quadric& C = a_side ? QA : QB;
-      const Quadric& O = a_side ? QB : QA;
-      if (std::abs(O.n.dot(q - O.foot(q))) > c.other_distance) return;  // no crease here
-      CurvedCrease& f = found[i];
-      f.v = v;
-      f.t = t;
-      Vec3 foot = C.foot(q);
-      f.chosen.n = C.normal_at(foot);
-      f.chosen.c = f.chosen.n.dot(foot);
-      foot = O.foot(q);
-      f.other.n = O.normal_at(foot);
-      f.other.c = f.other.n.dot(foot);
-      if (degrees_between((Minv_t * f.chosen.n).normalized(), (Minv_t * f.other.n).normalized()) < c.sharp_angle)
-        f.t = std::numeric_limits<double>::quiet_NaN();
+      if (sa.isZero() || sb.isZero()) break;
+      ma = sa.normalized();
+      mb = sb.normalized();
     }
+    if (degrees_between(ma, mb) < c.sharp_angle) return;
+    // Each side's points (kept ones), their sticks' samples and the
+    // side's outward direction (the sum of its sticks' inside -> outside
+    // directions).
+    keep.assign(P.size(), 1);
+    Vec3 oa, ob;
+    auto split = [&] {
+      for (auto* list : {&pa, &pb, &ia, &xa, &ib, &xb}) list->clear();
+      oa.setZero();
+      ob.setZero();
+      for (size_t k = 0; k < P.size(); ++k) {
+        if (!keep[k]) continue;
+        const Vec3 in = sticks.inside_sample(P[k]), out = sticks.outside_sample(P[k]);
+        (side[k] ? pb : pa).push_back(x[P[k]]);
+        (side[k] ? ib : ia).push_back(in);
+        (side[k] ? xb : xa).push_back(out);
+        (side[k] ? ob : oa) += out - in;
+      }
+      return pa.size() >= kSidePoints && pb.size() >= kSidePoints;
+    };
+    Quadric QA, QB;
+    if (!split() || !QA.fit(pa, oa) || !QB.fit(pb, ob)) return;
+    // Trimming: each point goes to the nearer quadric, and points farther
+    // than `trim` from both (the rounded crease the band threshold left
+    // in) are dropped; then both are refitted.
+    bool fitted = true;
+    for (uint32_t round = 0; round < c.trim_rounds && fitted; ++round) {
+      for (size_t k = 0; k < P.size(); ++k) {
+        const Vec3& p = x[P[k]];
+        const double da = std::abs(QA.n.dot(p - QA.foot(p))), db = std::abs(QB.n.dot(p - QB.foot(p)));
+        side[k] = db < da;
+        keep[k] = std::min(da, db) <= c.trim;
+      }
+      fitted = split() && QA.fit(pa, oa) && QB.fit(pb, ob);
+    }
+    if (!fitted || QA.residual > c.residual || QB.residual > c.residual) return;
+    Vec3 ca = Vec3::Zero(), cb = Vec3::Zero();
+    for (const Vec3& p : pa) ca += p;
+    for (const Vec3& p : pb) cb += p;
+    ca /= double(pa.size());
+    cb /= double(pb.size());
+    QA.stab(pa, ia, xa, c.stab_eps, c.stab_weight, kStabSolves);
+    QB.stab(pb, ib, xb, c.stab_eps, c.stab_weight, kStabSolves);
+    const double ga = QA.n.dot(cb - QA.foot(cb)), gb = QB.n.dot(ca - QB.foot(ca));
+    if ((ga < 0) != (gb < 0)) return;
+    const bool convex = ga < 0;
+    const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
+    const double tv = (x[v] - in).dot(out - in);
+    // Where the stick leaves each side's solid.
+    const double ta = leave(QA, in, out, tv), tb = leave(QB, in, out, tv);
+    if (std::isnan(ta) || std::isnan(tb)) return;
+    const double t = std::clamp(convex ? std::min(ta, tb) : std::max(ta, tb), c.margin, 1 - c.margin);
+    if (std::abs(t - tv) > c.max_move) return;
+    const bool a_side = convex ? ta <= tb : ta >= tb;
+    const Vec3 q = in + t * (out - in);
+    const Quadric& C = a_side ? QA : QB;
+    const Quadric& O = a_side ? QB : QA;
+    if (std::abs(O.n.dot(q - O.foot(q))) > c.other_distance) return;  // no crease here
+    CurvedCrease& f = found[i];
+    f.v = v;
+    f.t = t;
+    Vec3 foot = C.foot(q);
+    f.chosen.n = C.normal_at(foot);
+    f.chosen.c = f.chosen.n.dot(foot);
+    foot = O.foot(q);
+    f.other.n = O.normal_at(foot);
+    f.other.c = f.other.n.dot(foot);
+    if (degrees_between((Minv_t * f.chosen.n).normalized(), (Minv_t * f.other.n).normalized()) < c.sharp_angle)
+      f.t = std::numeric_limits<double>::quiet_NaN();
   };
   // Evidence: a crease between two curved faces is kept only where it
   // continues a proven crease. Locally it proves nothing: at 128^3 a tight
