@@ -55,9 +55,9 @@ std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
 // 2 stages it used to run at every size: the same faces and no spurious
 // flat on the CAD part, boxes and fandisk at 256^3, r->t within 2 %
 // (docs/BENCHMARKS.md, The flats' estimates).
-PressOptions estimate_options(const PressOptions& po, int levels) {
+PressOptions estimate_options(const PressOptions& po, int levels, int iterations) {
   PressOptions eo = po;
-  eo.iterations = detail::kEstimateIterations;
+  eo.iterations = iterations;
   eo.levels = levels;
   eo.tolerance = 0;
   eo.progress = nullptr;
@@ -71,11 +71,12 @@ PressOptions estimate_options(const PressOptions& po, int levels) {
 using Segmented = detail::FlatRun::Estimates;
 
 Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail::Layout& layout,
-                  const PressOptions& po, const FlatOptions& fo, const detail::Adjacency& graph) {
+                  const PressOptions& po, const FlatOptions& fo, const detail::Adjacency& graph,
+                  int first_iterations = detail::kEstimateIterations) {
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
-  g.options = estimate_options(po, press_levels(s, po.levels));
+  g.options = estimate_options(po, press_levels(s, po.levels), first_iterations);
   const PressOptions& eo = g.options;
   g.first = detail::press_on(g.est, layout, eo);
   double t_est = seconds_since(t0);
@@ -121,7 +122,9 @@ FlatSegmentation segment_flats(const StickSurface& s, const SliceCurves& curves,
                                const FlatOptions& fo) {
   detail::Layout layout;
   detail::make_layout(s, curves, layout);
-  return segment(s, curves, layout, po, fo, detail::Adjacency(s.stick_count(), s.triangles)).seg;
+  // Its press is discarded, so the first estimate only has to show the flats.
+  return segment(s, curves, layout, po, fo, detail::Adjacency(s.stick_count(), s.triangles),
+                 detail::kDiscardedEstimateIterations).seg;
 }
 
 FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,

@@ -166,7 +166,9 @@ struct FeaturePressStats {
 
 /// The flats and junctions of `surface` from its estimates (the first half
 /// of press_with_flats: press a copy, detect, press again with the flats
-/// frozen, detect); the surface is not changed.
+/// frozen, detect); the surface is not changed. Its first estimate is
+/// shorter than press_with_flats' (which may keep it as the final press):
+/// it only has to show the flats.
 FlatSegmentation segment_flats(const StickSurface& surface, const SliceCurves& curves, const PressOptions& options,
                                const FlatOptions& flat_options);
 
