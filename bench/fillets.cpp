@@ -1,11 +1,15 @@
 // The truth-known family for the sharp-edge decision (issue 75): a box whose
 // edges and corners are rounded with radius r cells (`voxpress generate box
-// --fillet R`; r = 0 is the sharp box), over several rotations, pressed by
+// --fillet R`; r = 0 is the sharp box), or a cylinder whose rims are
+// (`--shape cylinder`: a flat cap meets a curved side through the fillet),
+// over several rotations, pressed by
 // the default, `--no-sharpen` and `--no-flats`, each measured against its
 // exact truth by the same evaluate() as `voxpress eval` and bench/compare.
 // A fillet of radius r > 0 has no sharp edge, so every labelled edge there is
-// a false one (precision 0); at r = 0 the box's 12 edges are the truth.
+// a false one (precision 0); at r = 0 the box's 12 edges (the cylinder's
+// two rims) are the truth.
 //   build/bench/bench_fillets                                  # the table in docs/BENCHMARKS.md
+//   build/bench/bench_fillets --shape cylinder
 //   build/bench/bench_fillets --radii 0,1,3 --seeds 1,2 --res 96
 // Per radius and variant, means over the seeds: result -> truth RMS and
 // Hausdorff (voxels), mean normal error (degrees), sharp-edge recall /
@@ -58,16 +62,18 @@ std::string mean_or_dash(double sum, int n, double scale, int digits) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"The filleted-box family: the sharp-edge decision against the exact truth"};
-  std::string radii_arg = "0,0.5,1,1.5,2,3,4", seeds_arg = "1,2,3,4,5";
+  CLI::App app{"The filleted family: the sharp-edge decision against the exact truth"};
+  std::string radii_arg = "0,0.5,1,1.5,2,3,4", seeds_arg = "1,2,3,4,5", shape_arg = "box";
   int64_t res = 128;
   size_t samples = 100000;
   app.add_option("--radii", radii_arg, "Fillet radii in cells")->capture_default_str();
   app.add_option("--seeds", seeds_arg, "Rotations (random:N)")->capture_default_str();
   app.add_option("--res", res, "Resolution")->capture_default_str();
+  app.add_option("--shape", shape_arg, "box or cylinder")->capture_default_str();
   app.add_option("--samples", samples, "Area samples per direction")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   const std::vector<double> radii = split(radii_arg), seeds = split(seeds_arg);
+  const ShapeKind kind = parse_shape(shape_arg);
 
   std::vector<std::array<Figures, kVariantCount>> figures(radii.size());
   for (size_t ri = 0; ri < radii.size(); ++ri)
@@ -76,8 +82,8 @@ int main(int argc, char** argv) {
       go.res = res;
       go.rotation = parse_rotation("random:" + std::to_string(int(seed)));
       go.fillet = radii[ri];
-      const GeneratedShape g = generate_shape(ShapeKind::box, go);
-      const auto truth = shape_truth(ShapeKind::box, g.linear, g.translation, g.fillet);
+      const GeneratedShape g = generate_shape(kind, go);
+      const auto truth = shape_truth(kind, g.linear, g.translation, g.fillet);
       for (size_t vi = 0; vi < kVariantCount; ++vi) {
         SurfaceOptions so;
         for (Pass p : kVariants[vi].off) so.passes.disable(p);
@@ -104,9 +110,9 @@ int main(int argc, char** argv) {
       }
     }
 
-  std::printf("box, res %ld, rotations random:%s; means over the rotations: r->t RMS (vox) / normal error (deg) / "
+  std::printf("%s, res %ld, rotations random:%s; means over the rotations: r->t RMS (vox) / normal error (deg) / "
               "Hausdorff (vox) / sharp recall / precision (%%, within 0.5 vox) / labelled sharp edges\n\n",
-              long(res), seeds_arg.c_str());
+              shape_name(kind), long(res), seeds_arg.c_str());
   std::printf("| r (cells) |");
   for (const Variant& v : kVariants) std::printf(" %s |", v.name);
   std::printf(" default / best RMS |\n|---:|");

@@ -53,8 +53,8 @@ void register_generate(CLI::App& app, Global& g) {
   cmd->add_option("-o,--output", c->output, "Output volume (.nrrd, .nii.gz, .mha, .tif, .h5)")->required();
   c->place.bind(*cmd, "shape");
   cmd->add_option("--fillet", c->fillet,
-                  "Box only: round its edges and corners with this radius in cells (of the smallest spacing; "
-                  "0 = sharp). `eval` knows the rounded truth, which has no sharp edges")
+                  "Box or cylinder: round its edges (and corners) with this radius in cells (of the smallest "
+                  "spacing; 0 = sharp). `eval` knows the rounded truth, which has no sharp edges")
       ->capture_default_str();
   cmd->add_option("--stats-json", c->stats_json, "Write timings and counts as JSON");
   cmd->callback([c, &g] {

@@ -55,6 +55,12 @@ bool shape_contains(ShapeKind kind, const Vec3& m, double fillet) {
     const Vec3 inner = kBoxHalf - Vec3::Constant(fillet);
     return (m.cwiseAbs() - inner).cwiseMax(0.0).squaredNorm() <= fillet * fillet;
   }
+  if (kind == ShapeKind::cylinder && fillet > 0) {
+    // The same for the shrunk cylinder: its rims become quarter tori.
+    const double dr = std::max(0.0, std::hypot(m.x(), m.y()) - (kCylRadius - fillet));
+    const double dz = std::max(0.0, std::abs(m.z()) - (kCylHalf - fillet));
+    return dr * dr + dz * dz <= fillet * fillet;
+  }
   switch (kind) {
     case ShapeKind::sphere: return m.squaredNorm() <= 1.0;
     case ShapeKind::torus: {
@@ -91,6 +97,13 @@ double shape_volume(ShapeKind kind, double fillet) {
     const Vec3 h = kBoxHalf - Vec3::Constant(fillet);
     const double f = fillet;
     return 8 * h.prod() + 8 * (h.x() * h.y() + h.y() * h.z() + h.x() * h.z()) * f + 2 * pi * h.sum() * f * f +
+           4.0 / 3.0 * pi * f * f * f;
+  }
+  if (kind == ShapeKind::cylinder && fillet > 0) {
+    // Steiner's formula for the shrunk cylinder (radius r, half height h):
+    // V + S f + M f^2 + 4/3 pi f^3, M = 2 pi h + pi^2 r its integrated mean curvature.
+    const double r = kCylRadius - fillet, h = kCylHalf - fillet, f = fillet;
+    return 2 * pi * r * r * h + (4 * pi * r * h + 2 * pi * r * r) * f + (2 * pi * h + pi * pi * r) * f * f +
            4.0 / 3.0 * pi * f * f * f;
   }
   switch (kind) {
@@ -162,7 +175,8 @@ Mat3 parse_rotation(const std::string& spec) {
 GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
   const Mat3& R = o.rotation;
   if (!(o.fillet >= 0) || !std::isfinite(o.fillet)) throw UsageError("--fillet must be a finite radius >= 0");
-  if (o.fillet > 0 && kind != ShapeKind::box) throw UsageError("--fillet rounds the box's edges: use it with 'box'");
+  if (o.fillet > 0 && kind != ShapeKind::box && kind != ShapeKind::cylinder)
+    throw UsageError("--fillet rounds the edges of 'box' or 'cylinder' only");
   // Extent of the rotated shape along each world axis: support in +/- e_a.
   Vec3 lo, hi;
   for (int a = 0; a < 3; ++a) {
@@ -178,11 +192,12 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& o) {
   g.translation = place.translation;
   const Lattice& L = place.lattice;
   // The radius in cells of the smallest spacing, in model units; the
-  // lattice is the sharp box's (the rounded box lies inside it).
+  // lattice is the sharp shape's (the rounded one lies inside it).
   g.fillet = o.fillet * L.spacing.minCoeff() / g.scale;
-  if (g.fillet >= kBoxHalf.minCoeff())
-    throw UsageError("--fillet " + std::to_string(o.fillet) + " cells is not below the box's smallest half extent (" +
-                     std::to_string(kBoxHalf.minCoeff() * g.scale / L.spacing.minCoeff()) + " cells)");
+  const double smallest = kind == ShapeKind::cylinder ? std::min(kCylRadius, kCylHalf) : kBoxHalf.minCoeff();
+  if (g.fillet >= smallest)
+    throw UsageError("--fillet " + std::to_string(o.fillet) + " cells is not below the " + shape_name(kind) +
+                     "'s smallest half extent (" + std::to_string(smallest * g.scale / L.spacing.minCoeff()) + " cells)");
   if (kind == ShapeKind::cad_part) {
     // The part is its mesh: classify every sample exactly against it.
     Mesh physical;
@@ -272,8 +287,9 @@ std::vector<PlanarFace> shape_planar_faces(ShapeKind kind, double fillet) {
         }
       break;
     }
-    case ShapeKind::cylinder:
-      for (double s : {1.0, -1.0}) out.push_back({Vec3(0, 0, s), kCylHalf, std::numbers::pi * kCylRadius * kCylRadius});
+    case ShapeKind::cylinder:  // a filleted cap is its inner disc
+      for (double s : {1.0, -1.0})
+        out.push_back({Vec3(0, 0, s), kCylHalf, std::numbers::pi * (kCylRadius - fillet) * (kCylRadius - fillet)});
       break;
     case ShapeKind::cad_part:
       for (const PlanarFace& f : planar_faces(cad_part_mesh()))

@@ -27,7 +27,7 @@ class AnalyticTruth final : public Truth {
  public:
   AnalyticTruth(ShapeKind kind, const Mat3& linear, const Vec3& translation, double fillet)
       : kind_(kind), A_(linear), t_(translation), Ainv_(linear.inverse()), N_(linear.inverse().transpose()),
-        scale_(std::cbrt(std::abs(linear.determinant()))), fillet_(kind == ShapeKind::box ? fillet : 0) {}
+        scale_(std::cbrt(std::abs(linear.determinant()))), fillet_(kind == ShapeKind::box || kind == ShapeKind::cylinder ? fillet : 0) {}
 
   std::string describe() const override {
     std::string d = std::string(shape_name(kind_)) + " (analytic";
@@ -75,7 +75,10 @@ class AnalyticTruth final : public Truth {
     auto u = [&](int k) { return detail::uniform(seed, 8 * index + uint64_t(k)); };
     Vec3 q, n;
     if (fillet_ > 0) {
-      sample_filleted_box(u, q, n);
+      if (kind_ == ShapeKind::box)
+        sample_filleted_box(u, q, n);
+      else
+        sample_filleted_cylinder(seed, index, u, q, n);
       return {t_ + A_ * q, (N_ * n).normalized()};
     }
     switch (kind_) {
@@ -145,7 +148,12 @@ class AnalyticTruth final : public Truth {
         a = 8 * (h.x() * h.y() + h.y() * h.z() + h.x() * h.z()) + 4 * kPi * f * h.sum() + 4 * kPi * f * f;
         break;
       }
-      default: a = 2 * kPi * kCylR * 2 * kCylH + 2 * kPi * kCylR * kCylR; break;
+      default: {
+        // Side, caps and the two outer quarter tori (Pappus) of the shrunk cylinder r, h.
+        const double f = fillet_, r = kCylR - f, h = kCylH - f;
+        a = 2 * kPi * kCylR * 2 * h + 2 * kPi * r * r + 2 * (2 * kPi * f * (kPi / 2 * r + f));
+        break;
+      }
     }
     return a * scale_ * scale_;
   }
@@ -167,7 +175,7 @@ class AnalyticTruth final : public Truth {
             a[a2] = b[a2] = s2 * h[a2];
             add(a, b);
           }
-    } else if (kind_ == ShapeKind::cylinder && angle_deg < 90) {
+    } else if (kind_ == ShapeKind::cylinder && fillet_ == 0 && angle_deg < 90) {
       const int n = 1024;
       for (double z : {-kCylH, kCylH})
         for (int i = 0; i < n; ++i) {
@@ -234,6 +242,60 @@ class AnalyticTruth final : public Truth {
     }
   }
 
+  // The filleted cylinder (the shrunk cylinder r, h plus a ball of radius
+  // f), uniform by area: the side, a cap's disc or a rim's outer quarter
+  // torus, by their areas. On a rim, theta (0: outwards, pi/2: up) has
+  // density (r + f cos theta): rejection from a sub-stream, as the torus.
+  template <class U>
+  void sample_filleted_cylinder(uint64_t seed, uint64_t index, const U& u, Vec3& q, Vec3& n) const {
+    const double f = fillet_, r = kCylR - f, h = kCylH - f;
+    const double side = 2 * kPi * kCylR * 2 * h, cap = kPi * r * r, rim = 2 * kPi * f * (kPi / 2 * r + f);
+    const double phi = 2 * kPi * u(1);
+    const Vec3 dir(std::cos(phi), std::sin(phi), 0);
+    const double up = u(3) < 0.5 ? -1 : 1;
+    double pick = u(0) * (side + 2 * cap + 2 * rim);
+    if (pick < side) {
+      n = dir;
+      q = Vec3(kCylR * dir.x(), kCylR * dir.y(), (2 * u(2) - 1) * h);
+    } else if ((pick -= side) < 2 * cap) {
+      const double rho = r * std::sqrt(u(2));
+      q = Vec3(rho * dir.x(), rho * dir.y(), up * kCylH);
+      n = Vec3(0, 0, up);
+    } else {
+      double th = 0;
+      for (uint64_t k = 0; k < 64; ++k) {
+        th = kPi / 2 * detail::uniform(seed ^ 0x7f4a7c15u, 128 * index + 2 * k);
+        if (detail::uniform(seed ^ 0x7f4a7c15u, 128 * index + 2 * k + 1) * (r + f) <= r + f * std::cos(th)) break;
+      }
+      n = Vec3(std::cos(th) * dir.x(), std::cos(th) * dir.y(), up * std::sin(th));
+      q = Vec3(r * dir.x(), r * dir.y(), up * h) + f * n;
+    }
+  }
+
+  // The filleted cylinder's exact closest point, as the box's: from outside
+  // the shrunk cylinder along the direction from its nearest point; from
+  // inside it straight to the nearer of the side and the cap.
+  void closest_filleted_cylinder(const Vec3& m, Vec3& q, Vec3& n) const {
+    const double f = fillet_, r = kCylR - f, h = kCylH - f;
+    const double rho = std::hypot(m.x(), m.y());
+    const Vec3 dir = rho > 0 ? Vec3(m.x() / rho, m.y() / rho, 0) : Vec3::UnitX();
+    // Exactly m where m is inside (rho * dir would round off it).
+    const Vec3 c = rho <= r ? Vec3(m.x(), m.y(), std::clamp(m.z(), -h, h)) : Vec3(r * dir.x(), r * dir.y(), std::clamp(m.z(), -h, h));
+    const Vec3 d = m - c;
+    if (d.squaredNorm() > 0) {
+      n = d.normalized();
+      q = c + f * n;
+      return;
+    }
+    if (r - rho <= h - std::abs(m.z())) {
+      n = dir;
+      q = Vec3(kCylR * dir.x(), kCylR * dir.y(), m.z());
+    } else {
+      n = Vec3(0, 0, m.z() >= 0 ? 1 : -1);
+      q = Vec3(m.x(), m.y(), n.z() * kCylH);
+    }
+  }
+
   // The filleted box's exact closest point: from outside the shrunk box h,
   // along the direction from its nearest point c (distance |m - c| - f);
   // from inside it, straight to the nearest face (its flat part covers the
@@ -260,7 +322,7 @@ class AnalyticTruth final : public Truth {
 
   // Exact closest point q on the model surface and outward normal n.
   void closest_model(const Vec3& m, const Vec3& hint, Vec3& q, Vec3& n) const {
-    if (fillet_ > 0) return closest_filleted_box(m, q, n);
+    if (fillet_ > 0) return kind_ == ShapeKind::box ? closest_filleted_box(m, q, n) : closest_filleted_cylinder(m, q, n);
     switch (kind_) {
       case ShapeKind::sphere: {
         const double r = m.norm();
@@ -343,7 +405,7 @@ class AnalyticTruth final : public Truth {
   Vec3 t_;
   Mat3 Ainv_, N_;
   double scale_;
-  double fillet_;  // the box's fillet radius (model units), 0 otherwise
+  double fillet_;  // the box's or cylinder's fillet radius (model units), 0 otherwise
 };
 
 // ------------------------------------------------------------- mesh

@@ -161,7 +161,10 @@ bool is_junction(FlatsContext& ctx, size_t v, int32_t f0, detail::RingScratch& r
 // allowing kRoundBorderRadius or more is a resolved fillet: its vertices
 // are no junctions, so the extension does not freeze the fillet's start
 // onto a flat's plane (at r = 2-3 cells that flattening was most of the
-// error with and without sharpening). Returns the vertices released.
+// error with and without sharpening). Chains beside one flat are judged by
+// round_one_flat_borders. Returns the vertices released.
+size_t round_one_flat_borders(FlatsContext& ctx, const std::vector<std::array<int32_t, 2>>& pair);
+
 size_t round_borders(FlatsContext& ctx) {
   const Surface& S = ctx.S;
   FlatSegmentation& seg = ctx.seg;
@@ -200,6 +203,96 @@ size_t round_borders(FlatsContext& ctx) {
     evidence.add_rings(A, B, kind, chain, S.adj_off, S.adj, [&](uint32_t w) { return S.inside(w); },
                        [&](uint32_t w) { return S.outside(w); });
     if (!evidence.round_between(detail::kRoundBorderRadius)) continue;
+    for (uint32_t v : chain) seg.junction[v] = 0;
+    released += chain.size();
+  }
+  return released + round_one_flat_borders(ctx, pair);
+}
+
+// The plane of flat F's curved side around v: the fresh vertices within
+// rings [lo, hi] of v off F's plane, moved to touch them (a tangent plane
+// of the side; a secant through a fillet would leave part of it outside
+// and allow no rounding). `below`: the side falls inside F's plane (1) or
+// outside (-1). False without a plane (too few points, a thin row).
+bool side_plane(const FlatsContext& ctx, uint32_t v, const Flat& F, uint32_t lo, uint32_t hi,
+                detail::RingScratch& rs, std::vector<Vec3>& pts, Plane& out, int8_t& below) {
+  const Surface& S = ctx.S;
+  detail::rings_around(v, hi, S.adj_off, S.adj, Fresh{ctx.seg.region}, rs);
+  pts.clear();
+  Vec3 outward = Vec3::Zero();
+  double rise = 0;
+  for (const auto& [w, d] : rs.out) {
+    const double h = ctx.height(F, S.x[w]);
+    if (d < lo || std::abs(h) <= detail::kJunctionRingOffPlane * ctx.cell) continue;
+    pts.push_back(S.x[w]);
+    outward += S.outside(w) - S.inside(w);
+    rise += h;
+  }
+  if (pts.size() < 3) return false;
+  const Pca q = pca(pts);
+  if (!(q.eigenvalues(1) >= kThinRow * q.eigenvalues(2))) return false;
+  below = rise < 0 ? 1 : -1;
+  const Plane P = detail::oriented_plane(q, outward);
+  double c = below > 0 ? -INFINITY : INFINITY;
+  for (const Vec3& x : pts) c = below > 0 ? std::max(c, P.n.dot(x)) : std::min(c, P.n.dot(x));
+  out = {P.n, c};
+  return true;
+}
+
+// The same for a border between a flat and a curved side (no second flat
+// within kRoundBorderRings): a filleted cylinder's rim, a plate's rounded
+// end. Chains are connected junctions of the same flat, all convex (the
+// side falls inside the flat's plane) or all concave. What the samples
+// allow is judged against the side's plane next to the border (the
+// junction test's 2-ring: at a crease it is the side's own plane there, so
+// the crease's samples forbid a rounding), what they demand against the
+// side's plane beyond (kTangentRings: a fillet's far side, whose corner
+// with the flat the fillet cuts off).
+size_t round_one_flat_borders(FlatsContext& ctx, const std::vector<std::array<int32_t, 2>>& pair) {
+  const Surface& S = ctx.S;
+  FlatSegmentation& seg = ctx.seg;
+  const size_t n = ctx.n;
+  std::vector<std::array<Plane, 2>> side(n);  // near, far
+  std::vector<int32_t> flat(n, -1);
+  std::vector<int8_t> below(n, 0);
+  detail::parallel_ranges(n, 256, [&](detail::IndexRange r) {
+    detail::RingScratch& rs = ctx.scratch.local();
+    std::vector<Vec3> pts;
+    for (size_t v = r.begin(); v < r.end(); ++v) {
+      if (!seg.junction[v] || pair[v][0] >= 0) continue;
+      const int32_t f0 = first_flat(ctx, v);
+      if (f0 < 0) continue;
+      const Flat& F = seg.flats[size_t(f0)];
+      int8_t near_below = 0, far_below = 0;
+      if (!side_plane(ctx, uint32_t(v), F, 0, 2, rs, pts, side[v][0], near_below) ||
+          !side_plane(ctx, uint32_t(v), F, kTangentRings[0], kTangentRings[1], rs, pts, side[v][1], far_below) ||
+          near_below != far_below)
+        continue;
+      below[v] = near_below;
+      flat[v] = f0;
+    }
+  });
+  std::vector<uint8_t> seen(n, 0);
+  std::vector<uint32_t> chain;
+  size_t released = 0;
+  for (uint32_t v0 = 0; v0 < n; ++v0) {
+    if (flat[v0] < 0 || seen[v0]) continue;
+    chain.assign(1, v0);
+    seen[v0] = 1;
+    for (size_t k = 0; k < chain.size(); ++k)
+      for (uint32_t q = S.adj_off[chain[k]]; q < S.adj_off[chain[k] + 1]; ++q)
+        if (const uint32_t w = S.adj[q]; flat[w] == flat[v0] && !seen[w]) seen[w] = 1, chain.push_back(w);
+    const int kind = below[v0];
+    if (std::any_of(chain.begin(), chain.end(), [&](uint32_t v) { return below[v] != kind; })) continue;
+    const Flat& F = seg.flats[size_t(flat[v0])];
+    const Plane A{F.index_normal, F.index_offset};
+    detail::RoundingEvidence near, far;
+    for (uint32_t v : chain)
+      for (int k = 0; k < 2; ++k)
+        (k == 0 ? near : far).add_rings(A, side[v][size_t(k)], kind, {v}, S.adj_off, S.adj,
+                                        [&](uint32_t w) { return S.inside(w); }, [&](uint32_t w) { return S.outside(w); });
+    near.need = far.need;
+    if (!near.round_between(detail::kRoundBorderRadius)) continue;
     for (uint32_t v : chain) seg.junction[v] = 0;
     released += chain.size();
   }

@@ -52,7 +52,8 @@ const std::vector<PassInfo>& feature_passes() {
       {Pass::junctions, "junctions", "Section 3", "flats extended to their sharp edges; junction points", S::detect,
        detail::junctions_step},
       {Pass::round_borders, "round-borders", "beyond the paper (Section 3's junctions)",
-       "a chain of junctions between two flats whose samples allow a fillet the lattice resolves is a smooth border",
+       "a chain of junctions between two flats, or a flat and a curved side, whose samples allow a fillet the "
+       "lattice resolves is a smooth border",
        S::detect},
       {Pass::tangent_borders, "tangent-borders", "beyond the paper (Section 3's junctions)",
        "a would-be junction whose curved side continues the flat is a smooth border", S::detect},

@@ -160,6 +160,50 @@ TEST(Truth, FilletedBoxIsExactAndHasNoSharpEdges) {
   EXPECT_THROW(resolve_truth("", &v), InputError);
 }
 
+// The filleted cylinder (the family's one-flat case: a cap meets a curved
+// side through the fillet): its closest point and sampler agree; its area
+// is Steiner's derivative S + 2 M f + 4 pi f^2 of the shrunk cylinder's
+// volume polynomial (the code sums side, caps and Pappus' rims); the
+// generated volume counts the closed-form volume; no sharp edge.
+TEST(Truth, FilletedCylinderIsExactAndHasNoSharpEdges) {
+  test::Rng rng(6);
+  const Mat3 R = parse_rotation("random:13");
+  const double f = 0.25, pi = std::numbers::pi;  // the cylinder: radius 0.6, half height 1
+  const auto truth = shape_truth(ShapeKind::cylinder, 7.5 * R, Vec3(3, -2, 40), f);
+  expect_exact_closest_points(*truth, rng);
+  const double r = 0.6 - f, h = 1.0 - f;
+  const double S = 4 * pi * r * h + 2 * pi * r * r, M = 2 * pi * h + pi * pi * r;
+  EXPECT_NEAR(truth->area(), 7.5 * 7.5 * (S + 2 * M * f + 4 * pi * f * f), 1e-9);
+  EXPECT_TRUE(truth->sharp_edges(30).empty());
+  EXPECT_FALSE(shape_truth(ShapeKind::cylinder, 7.5 * R, Vec3(3, -2, 40), 0)->sharp_edges(30).empty());
+  // Uniform by area: the share of normals within 30 degrees of the axis is
+  // that of the caps and the rims' bands theta in [60, 90] degrees.
+  const Vec3 axis = (R * Vec3::UnitZ()).normalized();
+  const int n = 200000;
+  int near_axis = 0;
+  for (int i = 0; i < n; ++i) near_axis += std::abs(truth->sample(2, uint64_t(i)).normal.dot(axis)) > std::cos(pi / 6);
+  // A rim's band theta in [60, 90] degrees: the integral of 2 pi (r + f cos theta) f, times two rims.
+  const double band = 2 * 2 * pi * f * (r * (pi / 6) + f * (1 - std::sin(pi / 3)));
+  const double share = (2 * pi * r * r + band) / (S + 2 * M * f + 4 * pi * f * f);
+  EXPECT_NEAR(double(near_axis) / n, share, 0.005);
+  GenerateOptions o;
+  o.res = 48;
+  o.rotation = parse_rotation("random:4");
+  const GeneratedShape sharp = generate_shape(ShapeKind::cylinder, o);
+  o.fillet = 3;
+  const GeneratedShape round = generate_shape(ShapeKind::cylinder, o);
+  EXPECT_EQ(round.volume.lattice.dims, sharp.volume.lattice.dims);
+  size_t outside_sharp = 0;
+  for (size_t i = 0; i < sharp.volume.inside.size(); ++i) outside_sharp += round.volume.inside[i] && !sharp.volume.inside[i];
+  EXPECT_EQ(outside_sharp, 0u);
+  const double exact = shape_volume(ShapeKind::cylinder, round.fillet) * std::pow(round.scale, 3);
+  EXPECT_NEAR(double(round.volume.count_inside()) / exact, 1.0, 0.01);
+  EXPECT_NEAR(shape_truth(ShapeKind::cylinder, round.linear, round.translation, round.fillet)->volume(), exact,
+              1e-9 * exact);
+  o.fillet = 30;  // beyond the radius
+  EXPECT_THROW(generate_shape(ShapeKind::cylinder, o), UsageError);
+}
+
 TEST(Truth, ResolveFromVolumeMetadata) {
   ScalarVolume v;
   v.source = "vol.nrrd";

@@ -310,13 +310,45 @@ TEST(Flats, FilletsTheLatticeResolvesAreNotFlattened) {
   }
 }
 
+// The same beside one flat: a cylinder whose rims are rounded by 3 cells,
+// 64^3 (the cap meets the curved side through the fillet). The chains
+// along the rim allow that rounding against the side's plane next to the
+// border and the far side's corner demands it, so the cap is not extended
+// onto the fillet and no crease is fitted there; on the sharp cylinder the
+// rim's samples forbid it and its sharp curves keep their recall.
+TEST(Flats, FilletsBesideOneFlatAreNotFlattened) {
+  for (int seed : {1, 2}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    for (double r : {0.0, 3.0}) {
+      const test::RuleOnOff t =
+          test::rule_on_off(test::shape_and_truth(ShapeKind::cylinder, 64, seed, r), Pass::round_borders);
+      EvalOptions eo;
+      eo.volume = &t.box.shape.volume;
+      eo.samples = 40000;
+      eo.self_intersections = false;
+      const EvalReport on = evaluate(t.on.mesh, *t.box.truth, eo), off = evaluate(t.off.mesh, *t.box.truth, eo);
+      if (r == 0) {
+        ASSERT_TRUE(on.sharp_recall && off.sharp_recall);
+        EXPECT_GT(*on.sharp_recall, *off.sharp_recall - 0.015);
+        continue;
+      }
+      EXPECT_GT(t.count, 0u);
+      EXPECT_LT(on.result_to_truth_vox.rms, 0.9 * off.result_to_truth_vox.rms);
+    }
+  }
+}
+
 TEST(Flats, SharpEdgesEndingAtAFilletStayJunctions) {
   // The CAD part's sharp top and side edges end where a rounded vertical
   // edge begins: there the fillet cuts off samples deep inside both of the
   // sharp edge's planes, a demand no rounding of that edge explains. Such
   // short chains must stay junctions (RoundingEvidence::round_between), so
-  // round-borders costs the sharp curves' recall little (releasing them
-  // cost 1.9-2.0 points at these rotations).
+  // round-borders costs the sharp curves' recall little while it brings the
+  // surface closer to the truth. Its one-flat chains (the rounded vertical
+  // edges tangent to the side faces, the boss's concave fillet) cost
+  // 0.6-0.9 points here (a few cells of sharp curve where a tangent fillet
+  // begins) for 6-16 % of RMS; releasing the corner chains too would add
+  // 1.9-2.0 points.
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const test::RuleOnOff t = test::rule_on_off(test::shape_and_truth(ShapeKind::cad_part, 64, seed), Pass::round_borders);
@@ -327,7 +359,8 @@ TEST(Flats, SharpEdgesEndingAtAFilletStayJunctions) {
     const EvalReport a = evaluate(t.on.mesh, *t.box.truth, eo);
     const EvalReport b = evaluate(t.off.mesh, *t.box.truth, eo);
     ASSERT_TRUE(a.sharp_recall && b.sharp_recall);
-    EXPECT_GT(*a.sharp_recall, *b.sharp_recall - 0.015);
+    EXPECT_GT(*a.sharp_recall, *b.sharp_recall - 0.02);
+    EXPECT_LT(a.result_to_truth_vox.rms, 0.95 * b.result_to_truth_vox.rms);
   }
 }
 

@@ -38,9 +38,9 @@ std::vector<ShapeKind> all_shapes();
 ///            cylindrical boss (radius 0.35) with a concave fillet (radius
 ///            0.1) at its base, and a through hole (radius 0.18); defined by
 ///            its exact boundary mesh, cad_part_mesh() (the test is O(#faces))
-/// `fillet` (model units, box only): the box's edges and corners rounded
-/// with that radius, the Minkowski sum of the box shrunk by it and a ball
-/// (0: the sharp box; below its smallest half extent).
+/// `fillet` (model units, box and cylinder): the edges (and the box's
+/// corners) rounded with that radius, the Minkowski sum of the shape shrunk
+/// by it and a ball (0: the sharp shape; below its smallest half extent).
 bool shape_contains(ShapeKind kind, const Vec3& m, double fillet = 0);
 /// The CAD part's exact boundary representation in model units: a closed,
 /// manifold, outward triangle mesh (~0.3 M triangles; built once, ~0.1 s).
@@ -95,7 +95,7 @@ struct GeneratedShape {
   Mat3 linear = Mat3::Identity();
   Vec3 translation = Vec3::Zero();
   double scale = 1;  ///< physical units per model unit
-  double fillet = 0;  ///< the box's fillet radius in model units (GenerateOptions::fillet / scale)
+  double fillet = 0;  ///< the box's or cylinder's fillet radius in model units (GenerateOptions::fillet / scale)
 };
 
 GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& options);
@@ -104,7 +104,7 @@ GeneratedShape generate_shape(ShapeKind kind, const GenerateOptions& options);
 /// model -> physical transform (12 numbers: row-major 3x3, then translation).
 inline constexpr const char* kShapeKey = "voxpress_shape";
 inline constexpr const char* kModelToPhysicalKey = "voxpress_model_to_physical";
-/// The box's fillet radius in model units (absent: 0, the sharp box).
+/// The box's or cylinder's fillet radius in model units (absent: 0, sharp).
 inline constexpr const char* kFilletKey = "voxpress_fillet";
 
 }  // namespace voxpress

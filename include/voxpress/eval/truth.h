@@ -51,8 +51,8 @@ class Truth {
 
 /// An analytic shape placed by physical = translation + linear * model
 /// (linear a similarity, as generate_shape produces). The CAD part is a mesh
-/// truth. `fillet`: the box's fillet radius in model units (GeneratedShape::
-/// fillet); a filleted box has no sharp edges (its surface is C1).
+/// truth. `fillet`: the box's or cylinder's fillet radius in model units
+/// (GeneratedShape::fillet); a filleted shape has no sharp edges (C1).
 std::unique_ptr<Truth> shape_truth(ShapeKind kind, const Mat3& linear, const Vec3& translation, double fillet = 0);
 
 /// A closed mesh in the physical frame, taken by value. `name` is used by describe().
