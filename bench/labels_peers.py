@@ -25,13 +25,8 @@ import time
 import numpy as np
 from scipy import ndimage
 
-try:
-    import vtk
-    from vtk.util import numpy_support
-except ImportError:
-    sys.exit("bench/labels_peers.py: needs VTK's Python module (apt install python3-vtk9)")
-
 import voxpress
+from peers import slicer_filters  # exits with a message without python3-vtk9
 
 
 def boxes(labels):
@@ -83,27 +78,9 @@ def slicer_segments(labels):
         m = labels[box] == value
         padded = np.zeros(tuple(np.array(m.shape) + 2), dtype=np.uint8)
         padded[1:-1, 1:-1, 1:-1] = m
-        image = vtk.vtkImageData()
-        image.SetDimensions(*padded.shape)
-        image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(padded.ravel(order="F"), deep=True))
-        t0 = time.perf_counter()
-        fe = vtk.vtkDiscreteFlyingEdges3D()
-        fe.SetInputData(image)
-        fe.SetValue(0, 1)
-        fe.ComputeGradientsOff()
-        fe.ComputeNormalsOff()
-        fe.ComputeScalarsOff()
-        smoother = vtk.vtkWindowedSincPolyDataFilter()
-        smoother.SetInputConnection(fe.GetOutputPort())
-        smoother.SetNumberOfIterations(20)
-        smoother.SetPassBand(0.01)
-        smoother.BoundarySmoothingOff()
-        smoother.FeatureEdgeSmoothingOff()
-        smoother.NonManifoldSmoothingOn()
-        smoother.NormalizeCoordinatesOn()
-        smoother.Update()
-        seconds += time.perf_counter() - t0
-        triangles += smoother.GetOutput().GetNumberOfPolys()
+        poly, t = slicer_filters(padded)
+        seconds += t
+        triangles += poly.GetNumberOfPolys()
     return seconds, triangles
 
 

@@ -43,16 +43,11 @@ def run(cmd):
         sys.exit(f"bench/peers.py: {' '.join(cmd)}: {r.stderr.strip()}")
 
 
-def slicer_default(volume_path, out_path):
-    """Slicer's default labelmap -> closed surface; returns the filters' seconds."""
-    mask, lattice = voxpress.read_volume(volume_path)
-    nx, ny, nz = mask.shape
-    # One voxel of background around the mask (as Slicer pads), index space.
-    padded = np.zeros((nx + 2, ny + 2, nz + 2), dtype=np.uint8)
-    padded[1:-1, 1:-1, 1:-1] = mask != 0
+def slicer_filters(padded, origin=(0, 0, 0)):
+    """Slicer's two filters on a padded uint8 mask (index space): (vtkPolyData, seconds of the filters)."""
     image = vtk.vtkImageData()
-    image.SetDimensions(nx + 2, ny + 2, nz + 2)
-    image.SetOrigin(-1, -1, -1)
+    image.SetDimensions(*padded.shape)
+    image.SetOrigin(*origin)
     image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(padded.ravel(order="F"), deep=True))
     t0 = time.perf_counter()
     fe = vtk.vtkDiscreteFlyingEdges3D()
@@ -70,8 +65,17 @@ def slicer_default(volume_path, out_path):
     smoother.NonManifoldSmoothingOn()
     smoother.NormalizeCoordinatesOn()
     smoother.Update()
-    seconds = time.perf_counter() - t0
-    poly = smoother.GetOutput()
+    return smoother.GetOutput(), time.perf_counter() - t0
+
+
+def slicer_default(volume_path, out_path):
+    """Slicer's default labelmap -> closed surface; returns the filters' seconds."""
+    mask, lattice = voxpress.read_volume(volume_path)
+    nx, ny, nz = mask.shape
+    # One voxel of background around the mask (as Slicer pads), index space.
+    padded = np.zeros((nx + 2, ny + 2, nz + 2), dtype=np.uint8)
+    padded[1:-1, 1:-1, 1:-1] = mask != 0
+    poly, seconds = slicer_filters(padded, origin=(-1, -1, -1))
     idx = numpy_support.vtk_to_numpy(poly.GetPoints().GetData()).astype(np.float64)
     tris = numpy_support.vtk_to_numpy(poly.GetPolys().GetConnectivityArray()).reshape(-1, 3)
     # index -> physical: origin + direction diag(spacing) (i, j, k)

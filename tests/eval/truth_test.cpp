@@ -110,6 +110,30 @@ TEST(Truth, SharpEdges) {
   EXPECT_NEAR(cad, expected, 1e-3);
 }
 
+// Generated with a radius of `cells`: the same lattice as the sharp shape, a
+// subset of its samples, the closed-form volume (counted within 1 %, the
+// truth's exactly); a radius of `too_big` cells is refused.
+GeneratedShape expect_filleted_volume(ShapeKind kind, double cells, double too_big) {
+  GenerateOptions o;
+  o.res = 48;
+  o.rotation = parse_rotation("random:4");
+  const GeneratedShape sharp = generate_shape(kind, o);
+  o.fillet = cells;
+  GeneratedShape round = generate_shape(kind, o);
+  EXPECT_EQ(round.volume.lattice.dims, sharp.volume.lattice.dims);
+  EXPECT_NEAR(round.fillet * round.scale, cells, 1e-12);
+  size_t outside_sharp = 0;
+  for (size_t i = 0; i < sharp.volume.inside.size(); ++i) outside_sharp += round.volume.inside[i] && !sharp.volume.inside[i];
+  EXPECT_EQ(outside_sharp, 0u);
+  EXPECT_LT(round.volume.count_inside(), sharp.volume.count_inside());
+  const double exact = shape_volume(kind, round.fillet) * std::pow(round.scale, 3);
+  EXPECT_NEAR(double(round.volume.count_inside()) / exact, 1.0, 0.01);
+  EXPECT_NEAR(shape_truth(kind, round.linear, round.translation, round.fillet)->volume(), exact, 1e-9 * exact);
+  o.fillet = too_big;
+  EXPECT_THROW(generate_shape(kind, o), UsageError);
+  return round;
+}
+
 // The filleted box (issue 75's truth-known family): its closed-form closest
 // point, area sampler, area and volume agree with each other and with the
 // generated volume; the rounded box has no sharp edge, the sharp one 12; the
@@ -128,25 +152,8 @@ TEST(Truth, FilletedBoxIsExactAndHasNoSharpEdges) {
               1e-9);
   EXPECT_TRUE(truth->sharp_edges(30).empty());
   EXPECT_EQ(shape_truth(ShapeKind::box, 7.5 * R, Vec3(3, -2, 40), 0)->sharp_edges(30).size(), 12u);
-  // Generated with a radius in cells: the same lattice as the sharp box, a
-  // subset of its samples, and the closed-form volume.
+  const GeneratedShape round = expect_filleted_volume(ShapeKind::box, 4, 20);
   GenerateOptions o;
-  o.res = 48;
-  o.rotation = parse_rotation("random:4");
-  const GeneratedShape sharp = generate_shape(ShapeKind::box, o);
-  o.fillet = 4;
-  const GeneratedShape round = generate_shape(ShapeKind::box, o);
-  EXPECT_EQ(round.volume.lattice.dims, sharp.volume.lattice.dims);
-  EXPECT_NEAR(round.fillet * round.scale, 4.0, 1e-12);
-  size_t outside_sharp = 0;
-  for (size_t i = 0; i < sharp.volume.inside.size(); ++i) outside_sharp += round.volume.inside[i] && !sharp.volume.inside[i];
-  EXPECT_EQ(outside_sharp, 0u);
-  EXPECT_LT(round.volume.count_inside(), sharp.volume.count_inside());
-  const double exact = shape_volume(ShapeKind::box, round.fillet) * std::pow(round.scale, 3);
-  EXPECT_NEAR(double(round.volume.count_inside()) / exact, 1.0, 0.01);
-  EXPECT_NEAR(shape_truth(ShapeKind::box, round.linear, round.translation, round.fillet)->volume(), exact, 1e-9 * exact);
-  o.fillet = 20;  // beyond the smallest half extent
-  EXPECT_THROW(generate_shape(ShapeKind::box, o), UsageError);
   o.fillet = 1;
   EXPECT_THROW(generate_shape(ShapeKind::sphere, o), UsageError);
   // From the volume's metadata, as `eval` reads it.
@@ -186,22 +193,7 @@ TEST(Truth, FilletedCylinderIsExactAndHasNoSharpEdges) {
   const double band = 2 * 2 * pi * f * (r * (pi / 6) + f * (1 - std::sin(pi / 3)));
   const double share = (2 * pi * r * r + band) / (S + 2 * M * f + 4 * pi * f * f);
   EXPECT_NEAR(double(near_axis) / n, share, 0.005);
-  GenerateOptions o;
-  o.res = 48;
-  o.rotation = parse_rotation("random:4");
-  const GeneratedShape sharp = generate_shape(ShapeKind::cylinder, o);
-  o.fillet = 3;
-  const GeneratedShape round = generate_shape(ShapeKind::cylinder, o);
-  EXPECT_EQ(round.volume.lattice.dims, sharp.volume.lattice.dims);
-  size_t outside_sharp = 0;
-  for (size_t i = 0; i < sharp.volume.inside.size(); ++i) outside_sharp += round.volume.inside[i] && !sharp.volume.inside[i];
-  EXPECT_EQ(outside_sharp, 0u);
-  const double exact = shape_volume(ShapeKind::cylinder, round.fillet) * std::pow(round.scale, 3);
-  EXPECT_NEAR(double(round.volume.count_inside()) / exact, 1.0, 0.01);
-  EXPECT_NEAR(shape_truth(ShapeKind::cylinder, round.linear, round.translation, round.fillet)->volume(), exact,
-              1e-9 * exact);
-  o.fillet = 30;  // beyond the radius
-  EXPECT_THROW(generate_shape(ShapeKind::cylinder, o), UsageError);
+  expect_filleted_volume(ShapeKind::cylinder, 3, 30);
 }
 
 TEST(Truth, ResolveFromVolumeMetadata) {
