@@ -25,6 +25,24 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr size_t kSidePoints = 12;  // fewest points of a curved crease's side (Quadric::fit's minimum)
 constexpr uint32_t kChainGap = 2;  // rings a curved crease's chain may skip (a vertex whose sides' fit failed)
 
+// Whether a sample of v or its 1-ring lies kRoundEvidence past both the
+// flat's plane and the side's surface Q, on the wrong side for a crease
+// (crease_targets).
+bool denies_crease(const StickSurface& sticks, const Flat& f, const detail::Quadric& Q, bool convex, uint32_t v,
+                   const std::vector<uint32_t>& off, const std::vector<uint32_t>& adj) {
+  const double norm = f.index_normal.norm(), eps = detail::kRoundEvidence;
+  for (uint32_t k = off[v]; k <= off[v + 1]; ++k) {
+    const uint32_t w = k == off[v + 1] ? v : adj[k];
+    const Vec3 p = convex ? sticks.outside_sample(w) : sticks.inside_sample(w);
+    const double hf = (f.index_normal.dot(p) - f.index_offset) / norm;
+    const Vec3 d = p - Q.m;
+    const double a = Q.u.dot(d), b = Q.w.dot(d);
+    const double hq = Q.n.dot(d) - (Q.q(0) * a * a + Q.q(1) * a * b + Q.q(2) * b * b + Q.q(3) * a + Q.q(4) * b + Q.q(5));
+    if (convex ? (hf < -eps && hq < -eps) : (hf > eps && hq > eps)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 namespace detail {
@@ -84,6 +102,13 @@ std::vector<std::pair<uint32_t, double>> crease_targets(const StickSurface& stic
       double tf = leave(Plane{f.index_normal, f.index_offset}, in, out);
       if (std::isnan(tf)) tf = -kInf;  // the stick enters the flat's half-space: never in it before
       const bool convex = f.index_normal.dot(Q.m) < f.index_offset;
+      // The samples deny the crease when one of v's or its 1-ring's lies
+      // kRoundEvidence on the wrong side of both (an outside sample inside
+      // the flat's half-space and under the side's surface at a convex
+      // crease, an inside one above both at a concave one): the border is
+      // rounder than the crease of the flat and the side's far surface (a
+      // fillet the flat meets tangentially); v keeps its pressed place.
+      if (denies_crease(sticks, f, Q, convex, v, off, adj)) continue;
       const double t = std::clamp(convex ? std::min(tc, tf) : std::max(tc, tf), c.margin, 1 - c.margin);
       if (std::abs(t - tv) <= c.max_move) t_new[i] = t;
     }

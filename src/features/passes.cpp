@@ -67,7 +67,9 @@ const std::vector<PassInfo>& feature_passes() {
       {Pass::free_ends, "free-ends", "Section 4, beyond the paper", "slice curves cut at barriers keep open ends", S::press},
       // ---- Stage::crease_round, after the first press (press_with_flats)
       {Pass::crease_fit, "crease-fit", "beyond the paper",
-       "curved vertices next to a sharp flat border placed by the curved side's quadric", S::crease_round,
+       "curved vertices next to a sharp flat border placed by the curved side's quadric, unless a sample denies the "
+       "crease",
+       S::crease_round,
        detail::crease_fit_step},
       {Pass::curved_creases, "curved-creases", "beyond the paper",
        "creases between two curved faces placed by both sides' quadrics (and sharpened)", S::crease_round,

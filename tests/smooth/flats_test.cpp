@@ -314,8 +314,10 @@ TEST(Flats, FilletsTheLatticeResolvesAreNotFlattened) {
 // 64^3 (the cap meets the curved side through the fillet). The chains
 // along the rim allow that rounding against the side's plane next to the
 // border and the far side's corner demands it, so the cap is not extended
-// onto the fillet and no crease is fitted there; on the sharp cylinder the
-// rim's samples forbid it and its sharp curves keep their recall.
+// onto the fillet (measured 0.91-0.92 of the RMS with the rule off, where
+// only the crease fit's own check keeps the fillet round); on the sharp
+// cylinder the rim's samples forbid it and its sharp curves keep their
+// recall.
 TEST(Flats, FilletsBesideOneFlatAreNotFlattened) {
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
@@ -333,7 +335,35 @@ TEST(Flats, FilletsBesideOneFlatAreNotFlattened) {
         continue;
       }
       EXPECT_GT(t.count, 0u);
-      EXPECT_LT(on.result_to_truth_vox.rms, 0.9 * off.result_to_truth_vox.rms);
+      EXPECT_LT(on.result_to_truth_vox.rms, 0.95 * off.result_to_truth_vox.rms);
+    }
+  }
+}
+
+// The crease fit squares a flat's border off onto the crease of its plane
+// and the curved side's far surface; where a sample lies past both (a
+// fillet the flat meets tangentially) the samples deny that crease and the
+// vertex keeps its pressed place. On the sharp cylinder (64^3) the fit is
+// the better surface; on one whose rims are rounded by 2 cells (too tight
+// for round-borders to release) it costs 3-8 % here, 14-17 % before the
+// samples could deny it.
+TEST(Flats, CreaseFitKeepsOffFillets) {
+  for (int seed : {1, 2}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    for (double r : {0.0, 2.0}) {
+      const test::RuleOnOff t =
+          test::rule_on_off(test::shape_and_truth(ShapeKind::cylinder, 64, seed, r), Pass::crease_fit);
+      EvalOptions eo;
+      eo.volume = &t.box.shape.volume;
+      eo.samples = 40000;
+      eo.self_intersections = false;
+      const double on = evaluate(t.on.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
+      const double off = evaluate(t.off.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
+      EXPECT_GT(t.count, 0u);
+      if (r == 0)
+        EXPECT_LT(on, off);
+      else
+        EXPECT_LT(on, 1.1 * off);
     }
   }
 }
@@ -343,12 +373,11 @@ TEST(Flats, SharpEdgesEndingAtAFilletStayJunctions) {
   // edge begins: there the fillet cuts off samples deep inside both of the
   // sharp edge's planes, a demand no rounding of that edge explains. Such
   // short chains must stay junctions (RoundingEvidence::round_between), so
-  // round-borders costs the sharp curves' recall little while it brings the
-  // surface closer to the truth. Its one-flat chains (the rounded vertical
-  // edges tangent to the side faces, the boss's concave fillet) cost
-  // 0.6-0.9 points here (a few cells of sharp curve where a tangent fillet
-  // begins) for 6-16 % of RMS; releasing the corner chains too would add
-  // 1.9-2.0 points.
+  // round-borders costs the sharp curves' recall little. Its one-flat
+  // chains (the rounded vertical edges tangent to the side faces, the
+  // boss's concave fillet) cost 0.6-0.9 points here (a few cells of sharp
+  // curve where a tangent fillet begins); releasing the corner chains too
+  // would add 1.9-2.0 points.
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const test::RuleOnOff t = test::rule_on_off(test::shape_and_truth(ShapeKind::cad_part, 64, seed), Pass::round_borders);
@@ -360,7 +389,6 @@ TEST(Flats, SharpEdgesEndingAtAFilletStayJunctions) {
     const EvalReport b = evaluate(t.off.mesh, *t.box.truth, eo);
     ASSERT_TRUE(a.sharp_recall && b.sharp_recall);
     EXPECT_GT(*a.sharp_recall, *b.sharp_recall - 0.02);
-    EXPECT_LT(a.result_to_truth_vox.rms, 0.95 * b.result_to_truth_vox.rms);
   }
 }
 
