@@ -1,6 +1,7 @@
 // Flats (plane voting) and junctions: the planes found on solids whose
 // planar faces are known exactly, the guarantees of the pipeline on the
 // property corpus, determinism, and the stick-level invariants.
+#include <array>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -283,6 +284,16 @@ TEST(Flats, FilletTangentToAFlatIsNotAJunction) {
   }
 }
 
+// A rule's results with it on and off against the shape's truth
+// (`samples` per direction; the guarantees were checked by rule_on_off).
+std::array<EvalReport, 2> evaluate_on_off(const test::RuleOnOff& t, size_t samples) {
+  EvalOptions eo;
+  eo.volume = &t.box.shape.volume;
+  eo.samples = samples;
+  eo.self_intersections = false;
+  return {evaluate(t.on.mesh, *t.box.truth, eo), evaluate(t.off.mesh, *t.box.truth, eo)};
+}
+
 // Issue 75's family: a box whose edges are rounded by 2.5 cells, 64^3. The
 // lattice resolves that fillet: the junction chains along it allow that
 // rounding and no sharp edge does (round-borders), so the flats are not
@@ -299,13 +310,8 @@ TEST(Flats, FilletsTheLatticeResolvesAreNotFlattened) {
         continue;
       }
       EXPECT_GT(t.count, 0u);
-      EvalOptions eo;
-      eo.volume = &t.box.shape.volume;
-      eo.samples = 40000;
-      eo.self_intersections = false;
-      const double on_rms = evaluate(t.on.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
-      const double off_rms = evaluate(t.off.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
-      EXPECT_LT(on_rms, 0.9 * off_rms);
+      const auto [on, off] = evaluate_on_off(t, 40000);
+      EXPECT_LT(on.result_to_truth_vox.rms, 0.9 * off.result_to_truth_vox.rms);
     }
   }
 }
@@ -324,11 +330,7 @@ TEST(Flats, FilletsBesideOneFlatAreNotFlattened) {
     for (double r : {0.0, 3.0}) {
       const test::RuleOnOff t =
           test::rule_on_off(test::shape_and_truth(ShapeKind::cylinder, 64, seed, r), Pass::round_borders);
-      EvalOptions eo;
-      eo.volume = &t.box.shape.volume;
-      eo.samples = 40000;
-      eo.self_intersections = false;
-      const EvalReport on = evaluate(t.on.mesh, *t.box.truth, eo), off = evaluate(t.off.mesh, *t.box.truth, eo);
+      const auto [on, off] = evaluate_on_off(t, 40000);
       if (r == 0) {
         ASSERT_TRUE(on.sharp_recall && off.sharp_recall);
         EXPECT_GT(*on.sharp_recall, *off.sharp_recall - 0.015);
@@ -353,12 +355,8 @@ TEST(Flats, CreaseFitKeepsOffFillets) {
     for (double r : {0.0, 2.0}) {
       const test::RuleOnOff t =
           test::rule_on_off(test::shape_and_truth(ShapeKind::cylinder, 64, seed, r), Pass::crease_fit);
-      EvalOptions eo;
-      eo.volume = &t.box.shape.volume;
-      eo.samples = 40000;
-      eo.self_intersections = false;
-      const double on = evaluate(t.on.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
-      const double off = evaluate(t.off.mesh, *t.box.truth, eo).result_to_truth_vox.rms;
+      const auto [a, b] = evaluate_on_off(t, 40000);
+      const double on = a.result_to_truth_vox.rms, off = b.result_to_truth_vox.rms;
       EXPECT_GT(t.count, 0u);
       if (r == 0)
         EXPECT_LT(on, off);
@@ -381,12 +379,7 @@ TEST(Flats, SharpEdgesEndingAtAFilletStayJunctions) {
   for (int seed : {1, 2}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const test::RuleOnOff t = test::rule_on_off(test::shape_and_truth(ShapeKind::cad_part, 64, seed), Pass::round_borders);
-    EvalOptions eo;
-    eo.volume = &t.box.shape.volume;
-    eo.samples = 20000;
-    eo.self_intersections = false;
-    const EvalReport a = evaluate(t.on.mesh, *t.box.truth, eo);
-    const EvalReport b = evaluate(t.off.mesh, *t.box.truth, eo);
+    const auto [a, b] = evaluate_on_off(t, 20000);
     ASSERT_TRUE(a.sharp_recall && b.sharp_recall);
     EXPECT_GT(*a.sharp_recall, *b.sharp_recall - 0.02);
   }
