@@ -35,9 +35,7 @@ bool denies_crease(const StickSurface& sticks, const Flat& f, const detail::Quad
     const uint32_t w = k == off[v + 1] ? v : adj[k];
     const Vec3 p = convex ? sticks.outside_sample(w) : sticks.inside_sample(w);
     const double hf = (f.index_normal.dot(p) - f.index_offset) / norm;
-    const Vec3 d = p - Q.m;
-    const double a = Q.u.dot(d), b = Q.w.dot(d);
-    const double hq = Q.n.dot(d) - (Q.q(0) * a * a + Q.q(1) * a * b + Q.q(2) * b * b + Q.q(3) * a + Q.q(4) * b + Q.q(5));
+    const double hq = Q.height_above(p);
     if (convex ? (hf < -eps && hq < -eps) : (hf > eps && hq > eps)) return true;
   }
   return false;

@@ -75,13 +75,15 @@ struct Quadric {
   void stab(const std::vector<Vec3>& pts, const std::vector<Vec3>& ins, const std::vector<Vec3>& outs, double eps,
             double weight, int iters);  // smooth/quadric_fit.cpp
 
-  // The surface point above (or below) p along n.
-  Vec3 foot(const Vec3& p) const {
+  // Height of p above the surface along n: negative inside the solid.
+  double height_above(const Vec3& p) const {
     const Vec3 d = p - m;
     const double a = u.dot(d), b = w.dot(d);
-    const double h = q(0) * a * a + q(1) * a * b + q(2) * b * b + q(3) * a + q(4) * b + q(5);
-    return p + (h - n.dot(d)) * n;
+    return n.dot(d) - (q(0) * a * a + q(1) * a * b + q(2) * b * b + q(3) * a + q(4) * b + q(5));
   }
+
+  // The surface point above (or below) p along n.
+  Vec3 foot(const Vec3& p) const { return p - height_above(p) * n; }
 
   // Unit outward normal of the surface above (or below) point p.
   Vec3 normal_at(const Vec3& p) const {
