@@ -166,19 +166,12 @@ std::vector<uint8_t> fit_in_waves(const std::vector<uint32_t>& members, const st
     std::iota(wave.begin(), wave.end(), 0u);
   } else {
     // Within c.rings rings of a proven feature: one search from all of them.
-    std::vector<uint8_t> depth(n, UINT8_MAX);
-    std::vector<uint32_t> front, ahead;
+    std::vector<uint32_t> depth(n, kUnreached), front;
     for (uint32_t v = 0; v < n; ++v)
       if (role[v] != kCreaseFree && region[v] < 0) depth[v] = 0, front.push_back(v);
-    for (uint32_t d = 1; d <= c.rings && !front.empty(); ++d) {
-      ahead.clear();
-      for (uint32_t u : front)
-        for (uint32_t k = off[u]; k < off[u + 1]; ++k)
-          if (depth[adj[k]] == UINT8_MAX) depth[adj[k]] = uint8_t(d), ahead.push_back(adj[k]);
-      front.swap(ahead);
-    }
+    spread_rings(std::move(front), 0, uint32_t(c.rings), off, adj, depth, [](uint32_t, uint32_t) { return true; });
     for (uint32_t i = 0; i < members.size(); ++i)
-      if (depth[members[i]] != UINT8_MAX) wave.push_back(i);
+      if (depth[members[i]] != kUnreached) wave.push_back(i);
   }
   std::vector<int32_t> member_of(c.network ? n : 0, -1);
   if (c.network)
@@ -286,7 +279,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
     for (uint32_t round = 0; round < c.trim_rounds && fitted; ++round) {
       for (size_t k = 0; k < P.size(); ++k) {
         const Vec3& p = x[P[k]];
-        const double da = std::abs(QA.n.dot(p - QA.foot(p))), db = std::abs(QB.n.dot(p - QB.foot(p)));
+        const double da = std::abs(QA.height_above(p)), db = std::abs(QB.height_above(p));
         side[k] = db < da;
         keep[k] = std::min(da, db) <= c.trim;
       }
@@ -300,7 +293,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
     cb /= double(pb.size());
     QA.stab(pa, ia, xa, c.stab_eps, c.stab_weight, kStabSolves);
     QB.stab(pb, ib, xb, c.stab_eps, c.stab_weight, kStabSolves);
-    const double ga = QA.n.dot(cb - QA.foot(cb)), gb = QB.n.dot(ca - QB.foot(ca));
+    const double ga = QA.height_above(cb), gb = QB.height_above(ca);
     if ((ga < 0) != (gb < 0)) return;
     const bool convex = ga < 0;
     const Vec3 in = sticks.inside_sample(v), out = sticks.outside_sample(v);
@@ -314,7 +307,7 @@ std::vector<CurvedCrease> curved_crease_targets(const StickSurface& sticks, cons
     const Vec3 q = in + t * (out - in);
     const Quadric& C = a_side ? QA : QB;
     const Quadric& O = a_side ? QB : QA;
-    if (std::abs(O.n.dot(q - O.foot(q))) > c.other_distance) return;  // no crease here
+    if (std::abs(O.height_above(q)) > c.other_distance) return;  // no crease here
     CurvedCrease& f = found[i];
     f.v = v;
     f.t = t;

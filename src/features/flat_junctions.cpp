@@ -165,6 +165,17 @@ bool is_junction(FlatsContext& ctx, size_t v, int32_t f0, detail::RingScratch& r
 // round_one_flat_borders. Returns the vertices released.
 size_t round_one_flat_borders(FlatsContext& ctx, const std::vector<std::array<int32_t, 2>>& pair);
 
+// The connected vertices w from v0 that same(w) admits and `seen` does not
+// hold yet, v0 first (all marked seen): a chain of junctions.
+template <class Same>
+void grow_chain(const Surface& S, uint32_t v0, Same same, std::vector<uint8_t>& seen, std::vector<uint32_t>& chain) {
+  chain.assign(1, v0);
+  seen[v0] = 1;
+  for (size_t k = 0; k < chain.size(); ++k)
+    for (uint32_t q = S.adj_off[chain[k]]; q < S.adj_off[chain[k] + 1]; ++q)
+      if (const uint32_t w = S.adj[q]; !seen[w] && same(w)) seen[w] = 1, chain.push_back(w);
+}
+
 size_t round_borders(FlatsContext& ctx) {
   const Surface& S = ctx.S;
   FlatSegmentation& seg = ctx.seg;
@@ -189,11 +200,7 @@ size_t round_borders(FlatsContext& ctx) {
   size_t released = 0;
   for (uint32_t v0 = 0; v0 < n; ++v0) {
     if (!seg.junction[v0] || seen[v0] || pair[v0][0] < 0) continue;
-    chain.assign(1, v0);
-    seen[v0] = 1;
-    for (size_t k = 0; k < chain.size(); ++k)
-      for (uint32_t q = S.adj_off[chain[k]]; q < S.adj_off[chain[k] + 1]; ++q)
-        if (const uint32_t w = S.adj[q]; seg.junction[w] && !seen[w] && pair[w] == pair[v0]) seen[w] = 1, chain.push_back(w);
+    grow_chain(S, v0, [&](uint32_t w) { return seg.junction[w] && pair[w] == pair[v0]; }, seen, chain);
     const Flat& FA = seg.flats[size_t(pair[v0][0])];
     const Flat& FB = seg.flats[size_t(pair[v0][1])];
     const Plane A{FA.index_normal, FA.index_offset}, B{FB.index_normal, FB.index_offset};
@@ -209,21 +216,22 @@ size_t round_borders(FlatsContext& ctx) {
   return released + round_one_flat_borders(ctx, pair);
 }
 
-// The plane of flat F's curved side around v: the fresh vertices within
-// rings [lo, hi] of v off F's plane, moved to touch them (a tangent plane
-// of the side; a secant through a fillet would leave part of it outside
-// and allow no rounding). `below`: the side falls inside F's plane (1) or
-// outside (-1). False without a plane (too few points, a thin row).
-bool side_plane(const FlatsContext& ctx, uint32_t v, const Flat& F, uint32_t lo, uint32_t hi,
-                detail::RingScratch& rs, std::vector<Vec3>& pts, Plane& out, int8_t& below) {
+// The plane of flat F's curved side: the fresh vertices of `ring` (a
+// vertex's fresh rings, rings_around's output) at ring distance [lo, hi]
+// off F's plane, moved to touch them (a tangent plane of the side; a
+// secant through a fillet would leave part of it outside and allow no
+// rounding). `below`: the side falls inside F's plane (1) or outside (-1).
+// False without a plane (too few points, a thin row).
+bool side_plane(const FlatsContext& ctx, const std::vector<std::pair<uint32_t, uint32_t>>& ring, const Flat& F,
+                uint32_t lo, uint32_t hi, std::vector<Vec3>& pts, Plane& out, int8_t& below) {
   const Surface& S = ctx.S;
-  detail::rings_around(v, hi, S.adj_off, S.adj, Fresh{ctx.seg.region}, rs);
   pts.clear();
   Vec3 outward = Vec3::Zero();
   double rise = 0;
-  for (const auto& [w, d] : rs.out) {
+  for (const auto& [w, d] : ring) {
+    if (d < lo || d > hi) continue;
     const double h = ctx.height(F, S.x[w]);
-    if (d < lo || std::abs(h) <= detail::kJunctionRingOffPlane * ctx.cell) continue;
+    if (std::abs(h) <= detail::kJunctionRingOffPlane * ctx.cell) continue;
     pts.push_back(S.x[w]);
     outward += S.outside(w) - S.inside(w);
     rise += h;
@@ -264,8 +272,9 @@ size_t round_one_flat_borders(FlatsContext& ctx, const std::vector<std::array<in
       if (f0 < 0) continue;
       const Flat& F = seg.flats[size_t(f0)];
       int8_t near_below = 0, far_below = 0;
-      if (!side_plane(ctx, uint32_t(v), F, 0, 2, rs, pts, side[v][0], near_below) ||
-          !side_plane(ctx, uint32_t(v), F, kTangentRings[0], kTangentRings[1], rs, pts, side[v][1], far_below) ||
+      detail::rings_around(uint32_t(v), kTangentRings[1], S.adj_off, S.adj, Fresh{seg.region}, rs);
+      if (!side_plane(ctx, rs.out, F, 0, 2, pts, side[v][0], near_below) ||
+          !side_plane(ctx, rs.out, F, kTangentRings[0], kTangentRings[1], pts, side[v][1], far_below) ||
           near_below != far_below)
         continue;
       below[v] = near_below;
@@ -277,11 +286,7 @@ size_t round_one_flat_borders(FlatsContext& ctx, const std::vector<std::array<in
   size_t released = 0;
   for (uint32_t v0 = 0; v0 < n; ++v0) {
     if (flat[v0] < 0 || seen[v0]) continue;
-    chain.assign(1, v0);
-    seen[v0] = 1;
-    for (size_t k = 0; k < chain.size(); ++k)
-      for (uint32_t q = S.adj_off[chain[k]]; q < S.adj_off[chain[k] + 1]; ++q)
-        if (const uint32_t w = S.adj[q]; flat[w] == flat[v0] && !seen[w]) seen[w] = 1, chain.push_back(w);
+    grow_chain(S, v0, [&](uint32_t w) { return flat[w] == flat[v0]; }, seen, chain);
     const int kind = below[v0];
     if (std::any_of(chain.begin(), chain.end(), [&](uint32_t v) { return below[v] != kind; })) continue;
     const Flat& F = seg.flats[size_t(flat[v0])];

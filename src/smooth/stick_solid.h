@@ -39,7 +39,7 @@ inline double leave(const Plane& P, const Vec3& in, const Vec3& out) {
 inline double leave(const Quadric& Q, const Vec3& in, const Vec3& out, double near) {
   const double t = Q.exit(in, out, near, -1, 2);
   if (!std::isnan(t)) return t;
-  const double gi = Q.n.dot(in - Q.foot(in)), go = Q.n.dot(out - Q.foot(out));
+  const double gi = Q.height_above(in), go = Q.height_above(out);
   if (gi < 0 && go < 0) return INFINITY;
   if (gi > 0 && go > 0) return -INFINITY;
   return t;
