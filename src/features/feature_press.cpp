@@ -71,12 +71,11 @@ PressOptions estimate_options(const PressOptions& po, int levels, int iterations
 using Segmented = detail::FlatRun::Estimates;
 
 Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail::Layout& layout,
-                  const PressOptions& po, const FlatOptions& fo, const detail::Adjacency& graph,
-                  int first_iterations = detail::kEstimateIterations) {
+                  const PressOptions& po, const FlatOptions& fo, const detail::Adjacency& graph) {
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
-  g.options = estimate_options(po, press_levels(s, po.levels), first_iterations);
+  g.options = estimate_options(po, press_levels(s, po.levels), detail::kEstimateIterations);
   const PressOptions& eo = g.options;
   g.first = detail::press_on(g.est, layout, eo);
   double t_est = seconds_since(t0);
@@ -122,9 +121,7 @@ FlatSegmentation segment_flats(const StickSurface& s, const SliceCurves& curves,
                                const FlatOptions& fo) {
   detail::Layout layout;
   detail::make_layout(s, curves, layout);
-  // Its press is discarded, so the first estimate only has to show the flats.
-  return segment(s, curves, layout, po, fo, detail::Adjacency(s.stick_count(), s.triangles),
-                 detail::kDiscardedEstimateIterations).seg;
+  return segment(s, curves, layout, po, fo, detail::Adjacency(s.stick_count(), s.triangles)).seg;
 }
 
 FeaturePressStats press_with_flats(StickSurface& s, const SliceCurves& curves, const PressOptions& po,

@@ -17,7 +17,6 @@ constexpr double kRimTangentAngle = 15;  // degrees: a curved side continuing th
 constexpr double kMergeAngle = 4;        // degrees: adjacent flats this close are merged when one plane stabs both
 constexpr double kCurvedGain = 1.3;      // a quadric stabbing this many times as many sticks as the plane refuses the flat
 constexpr int kEstimateIterations = 100; // Pressing iterations of each estimate (the estimate's normals settle by then)
-constexpr int kDiscardedEstimateIterations = 30;  // the first estimate when it cannot become the final press (a label map's labels: the shared press is): 30 found every face (BENCHMARKS, The flats' estimates)
 constexpr int kSecondEstimateIterations = 50;  // the second estimate (flats frozen); 30 lost sharp precision on a 4-cell plate (BENCHMARKS, The flats' estimates)
 constexpr int kDetectionPasses = 2;      // the second re-estimates with the first's flats frozen (faces beside rounded edges)
 // --- junctions (Section 3)
