@@ -40,12 +40,6 @@ constexpr int kCurvedFitRings = 6;         // rings of a curved side's quadric (
 constexpr double kCurvedFitResidual = 0.05;  // cells RMS: the curved side's quadric is trusted up to this
 constexpr int kSnapRings = 8;              // rings searched for the flats around a curved band (snap)
 constexpr double kSnapTolerance = 0.05;    // cells: the flats' solid explains a stick within this (snap)
-// Of the margin, what a vertex put onto a flat's plane keeps from its samples
-// (snap, rim pockets): at the full margin every crossing within 1 % of a
-// sample left its vertex up to 0.01 cell off the plane (3,516 of 167,344
-// flat vertices of the 256^3 CAD part), a bump `press --faces` has to keep
-// (BENCHMARKS, Simplification); the float32 clearance is ~1e-5.
-constexpr double kFlatMarginShare = 0.1;
 constexpr double kSnapShare = 0.95;        // share of a band's sticks the flats' solid must explain (snap)
 constexpr double kWallThickness = 24;      // cells: a rim between two opposite flats this close is a wall (walls)
 constexpr int kFinalCreaseRings = 2;       // as kCreaseRings, once the regions are final (final-crease)

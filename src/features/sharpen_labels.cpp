@@ -217,7 +217,7 @@ void Sharpener::snap_to_flats() {
   });
   for (uint32_t v = 0; v < n; ++v) {
     if (flat[v] < 0) continue;
-    slide(v, t[v], flat_margin());  // t is already in [flat_margin, 1 - flat_margin]
+    slide(v, t[v]);  // t is already in [margin, 1 - margin]
     label[v] = flat[v];
     ++st.snapped;
   }
@@ -272,7 +272,7 @@ void Sharpener::join_leftovers() {
         continue;
       }
       pocket_slides.push_back({v, x[v]});  // judge_chains takes it back beside a chain left round
-      slide(v, t, flat_margin());
+      slide(v, t);
     }
     label[v] = f;
     if (small[v] == kLeftover) leftovers.push_back(v);  // a thin strip's vertices keep their place

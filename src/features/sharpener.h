@@ -149,15 +149,11 @@ struct Sharpener {
   static constexpr double kPastSample = 0.1;
   // Puts v on its stick at t, kept in [margin, 1 - margin] (no sample
   // changes side: Pressing's guarantee).
-  void slide(uint32_t v, double t) { slide(v, t, o.margin); }
-  void slide(uint32_t v, double t, double margin) {
+  void slide(uint32_t v, double t) {
     if (fixed && (*fixed)[v]) return;
     const Vec3 in = s.inside_sample(v);
-    x[v] = in + std::clamp(t, margin, 1 - margin) * (s.outside_sample(v) - in);
+    x[v] = in + std::clamp(t, o.margin, 1 - o.margin) * (s.outside_sample(v) - in);
   }
-  // The margin of a vertex put onto a flat's plane (snapped, a rim pocket):
-  // detail::kFlatMarginShare of the margin.
-  double flat_margin() const { return o.margin * detail::kFlatMarginShare; }
   double angle_deg(const Vec3& na, const Vec3& nb) const { return degrees_between(physical_normal(na), physical_normal(nb)); }
 
   // Beyond the paper: the 2-ring plane is a secant of a curved side, so on a
@@ -256,7 +252,7 @@ struct Sharpener {
   // when undecided or when the crossing misses the stick by more than
   // `snap_tolerance` cells along that plane's normal (or, with
   // `need_crease`, when no two of the flats meet at `min_angle` or more);
-  // else s in [flat_margin, 1 - flat_margin] (clamped) and the flat whose plane it is on.
+  // else s in [margin, 1 - margin] (clamped) and the flat whose plane it is on.
   struct SnapScratch {
     detail::RingScratch rings;
     std::vector<int32_t> near_flats;
@@ -305,7 +301,7 @@ struct Sharpener {
       if (convex ? at < best : at > best) best = at, flat = f, miss = miss_f;
     }
     if (miss > detail::kSnapTolerance) return false;  // every plane gave a finite `at`
-    s_out = std::clamp(best, flat_margin(), 1 - flat_margin());
+    s_out = std::clamp(best, o.margin, 1 - o.margin);
     return true;
   }
 

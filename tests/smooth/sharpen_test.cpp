@@ -186,40 +186,6 @@ TEST(Sharpen, JoinedVerticesTakeTheNearestPlane) {
   }
 }
 
-TEST(Sharpen, SnappedVerticesSitOnTheirPlane) {
-  // A vertex snapped onto a flat whose plane crosses its stick sits on the
-  // plane unless the crossing lies within a tenth of the margin of a sample
-  // (kFlatMarginShare); the leftovers and strips that join a flat keep
-  // their place. At the full margin every crossing within 1 % of a
-  // sample was left up to 0.01 cell off the plane: 2 % of a rotated face's
-  // vertices, each a bump the simplifier had to keep.
-  for (const int seed : {5, 7}) {
-    SCOPED_TRACE("cad part 128 seed " + std::to_string(seed));
-    const GeneratedShape g = shape(ShapeKind::cad_part, 128, seed);
-    const Sharpened r = run(g.volume);
-    const auto& region = r.after.vertex_attribute("region")->values;
-    const Lattice& L = r.surface.lattice;
-    const double margin = PressOptions{}.margin;
-    size_t snapped = 0, near_sample = 0, off = 0;  // joined vertices whose stick the plane crosses
-    for (uint32_t v = 0; v < r.surface.stick_count(); ++v) {
-      if (r.seg.region[v] >= 0 || region[v] < 0) continue;
-      const Flat& f = r.seg.flats[size_t(region[v])];
-      const Vec3 in = L.to_physical(r.surface.inside_sample(v)), out = L.to_physical(r.surface.outside_sample(v));
-      const double hi = f.normal.dot(in) - f.offset, ho = f.normal.dot(out) - f.offset;
-      if (!(hi < 0 && ho > 0)) continue;  // a sample on the plane's wrong side: no crossing to sit on
-      ++snapped;
-      const double t = -hi / (ho - hi);
-      if (t < margin || t > 1 - margin) ++near_sample;
-      off += std::abs(f.normal.dot(r.after.positions[v]) - f.offset) > 0.1 * margin * (out - in).norm() + 1e-9;
-    }
-    EXPECT_GT(snapped, 100u);
-    EXPECT_GT(near_sample, 10u) << "crossings within the margin of a sample";
-    // Off: the vertices that keep their place (leftovers, strips); at the
-    // full margin 46-53 % (seeds 5, 7), now a few %.
-    EXPECT_LT(off * 10, snapped) << off << " of " << snapped << " joined vertices off their plane";
-  }
-}
-
 TEST(Sharpen, SubdivisionFollowsFigure8) {
   const GeneratedShape g = shape(ShapeKind::box, 48, 4);
   const Sharpened r = run(g.volume);
