@@ -238,6 +238,7 @@ PyMesh py_press(const py::object& mask_like, const py::object& spacing, const py
   out.stats["vertices"] = out.mesh.vertex_count();
   out.stats["triangles"] = out.mesh.face_count();
   out.stats["iterations"] = pressing ? r.press.iterations : o.method == Method::cesn ? r.net.iterations : r.smooth.iterations;
+  if (pressing) out.stats["residual"] = r.press.residual;  // max |T(t) - t| reached, a fraction of the stick
   out.stats["flats"] = r.flats.flats.size();
   out.stats["sharp_edges"] = out.mesh.edges.size();
   out.stats["keeps_classification"] = keeps_classification(o.method);
@@ -275,6 +276,7 @@ py::object labels_result(const std::vector<LabelInfo>& chosen, std::vector<Mesh>
   PyMesh all;
   all.mesh = interfaces_mesh(shared->surface);
   all.stats["junction_curves"] = ps.junction_curves;
+  all.stats["residual"] = ps.interfaces.residual;  // the shared press's, as press()'s
   all.stats["cubes_pinned"] = ps.cubes_pinned;
   all.stats["cubes_reset"] = ps.cubes_reset;
   all.stats["flats"] = shared->flats ? shared->flats->flats.size() : 0;

@@ -96,6 +96,7 @@ nlohmann::json shared_json(const SharedLabels& r) {
       {"plane_curves", ps.plane_curves},
       {"continued_through_junctions", ps.continued},
       {"iterations", {{"junctions", ps.junctions.iterations}, {"interfaces", ps.interfaces.iterations}}},
+      {"residual", {{"junctions", ps.junctions.residual}, {"interfaces", ps.interfaces.residual}}},
       {"cubes_pinned", ps.cubes_pinned},
       {"cubes_reset", ps.cubes_reset},
       {"flats", nlohmann::json::array()},

@@ -36,6 +36,7 @@ def test_same_mesh_as_the_cli(tmp_path, method):
     np.testing.assert_array_equal(mesh.faces, ref.faces)
     np.testing.assert_array_equal(mesh.vertices, ref.vertices)  # PLY keeps doubles exactly
     assert mesh.stats["method"] == method
+    assert ("residual" in mesh.stats) == (method == "pressing")  # the press's residual reached (issue 74)
 
 
 def test_axes_order_and_spacing_match_a_nifti_read_with_nibabel(tmp_path):
@@ -278,6 +279,7 @@ def test_press_labels_every_label_at_once(tmp_path):
     # The shared surface is fitted and sharpened as one label alone would be; sharpen=False keeps the chamfers.
     _, chamfered = voxpress.press_labels(labels, spacing=(1, 1, 1.5), sharpen=False, interfaces=True)
     assert chamfered.stats["crease_vertices"] == 0 and chamfered.stats["fitted_vertices"] >= 0
+    assert 0 < chamfered.stats["residual"] < 1  # the shared press's, not converged in its 100 sweeps (issue 74)
     # Flats of the shared surface can be turned off: the plain shared press.
     plain, plain_shared = voxpress.press_labels(labels, spacing=(1, 1, 1.5), flats=False, interfaces=True)
     assert plain_shared.stats["flats"] == 0 and plain_shared.stats["flat_vertices"] == 0
