@@ -38,8 +38,9 @@ phase "sanitized build done"
 # volumes (their code runs in the suites kept, on smaller inputs); the
 # voxelizer at random rotations and the shared medical volumes' documented
 # facts (their code runs in the other Voxelize and VolumeIO tests and the
-# fuzzers); the filleted boxes' decision at 48^3 (39 s under ASan; the
-# round-chains pass runs in the sharpening's corpus) and the invariance
+# fuzzers); the filleted solids' decisions at 48-64^3 (39-85 s each under
+# ASan; their rules run in Flats.CreaseFitKeepsOffFillets, kept: a filleted
+# cylinder through the whole layer) and the invariance
 # checks (74 s, and 70 s for the default pipeline's and the moved origin's:
 # bitwise equality of t and meshes, whose code the corpora run under the
 # sanitizers). The corpus itself is smaller under the sanitizers
@@ -69,7 +70,9 @@ Pressing.AnisotropicSpacingWorksInPhysicalSpace:Voxelize.ExactAgainstTheModelAtR
 VolumeIO.SharedMedicalVolumesMatchTheirDocumentedFacts:Sharpen.FilletsTheLatticeResolvesStayRound:\
 Invariance.RealMaskShiftedPaddedAndCroppedGivesTheSameT:Invariance.ShiftedAndPaddedRotatedSphereGivesTheSameT:\
 Invariance.DefaultPipelineOnShiftedPaddedAndCroppedVolumes:Invariance.MovedOriginGivesTheSameT:\
-Simplify.SameBytesForAnyThreadCount"
+Simplify.SameBytesForAnyThreadCount:Flats.FilletsTheLatticeResolvesAreNotFlattened:\
+Flats.FilletsBesideOneFlatAreNotFlattened:Flats.SharpEdgesEndingAtAFilletStayJunctions:\
+Sharpen.StripsOfResolvedFilletsStayCurved"
 # The label maps' tests run the cases small enough for the sanitizers (each
 # stage of the shared surface: cases, extraction, press, fit, flats and
 # sharpening through press_shared_labels on the phantom, simplification);
