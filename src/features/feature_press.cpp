@@ -55,9 +55,9 @@ std::vector<uint8_t> frozen_of(const FlatSegmentation& f) {
 // 2 stages it used to run at every size: the same faces and no spurious
 // flat on the CAD part, boxes and fandisk at 256^3, r->t within 2 %
 // (docs/BENCHMARKS.md, The flats' estimates).
-PressOptions estimate_options(const PressOptions& po, int levels, int iterations) {
+PressOptions estimate_options(const PressOptions& po, int levels) {
   PressOptions eo = po;
-  eo.iterations = iterations;
+  eo.iterations = detail::kEstimateIterations;
   eo.levels = levels;
   eo.tolerance = 0;
   eo.progress = nullptr;
@@ -75,7 +75,7 @@ Segmented segment(const StickSurface& s, const SliceCurves& curves, const detail
   const auto t0 = std::chrono::steady_clock::now();
   Segmented g;
   g.est = s;
-  g.options = estimate_options(po, press_levels(s, po.levels), detail::kEstimateIterations);
+  g.options = estimate_options(po, press_levels(s, po.levels));
   const PressOptions& eo = g.options;
   g.first = detail::press_on(g.est, layout, eo);
   double t_est = seconds_since(t0);
