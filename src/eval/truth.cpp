@@ -74,11 +74,8 @@ class AnalyticTruth final : public Truth {
   SurfacePoint sample(uint64_t seed, uint64_t index) const override {
     auto u = [&](int k) { return detail::uniform(seed, 8 * index + uint64_t(k)); };
     Vec3 q, n;
-    if (fillet_ > 0) {
-      if (kind_ == ShapeKind::box)
-        sample_filleted_box(u, q, n);
-      else
-        sample_filleted_cylinder(seed, index, u, q, n);
+    if (fillet_ > 0 && kind_ == ShapeKind::box) {
+      sample_filleted_box(u, q, n);
       return {t_ + A_ * q, (N_ * n).normalized()};
     }
     switch (kind_) {
@@ -88,16 +85,8 @@ class AnalyticTruth final : public Truth {
         break;
       }
       case ShapeKind::torus: {
-        // Area element (R + r cos v): rejection sampling on v, from a
-        // sub-stream of this index (acceptance 1/1.4; 64 tries never all fail
-        // in practice, and the last one is taken if they do).
-        double v = 0;
-        for (uint64_t k = 0; k < 64; ++k) {
-          v = 2 * kPi * detail::uniform(seed ^ 0x9e37u, 128 * index + 2 * k);
-          if (detail::uniform(seed ^ 0x9e37u, 128 * index + 2 * k + 1) * (kTorusR + kTorusr) <=
-              kTorusR + kTorusr * std::cos(v))
-            break;
-        }
+        // Area element (R + r cos v): v by cosine_weighted.
+        const double v = cosine_weighted(seed ^ 0x9e37u, index, 2 * kPi, kTorusR, kTorusr);
         const double w = 2 * kPi * detail::uniform(seed ^ 0x5bd1e995u, index);
         n = Vec3(std::cos(v) * std::cos(w), std::cos(v) * std::sin(w), std::sin(v));
         q = Vec3(kTorusR * std::cos(w), kTorusR * std::sin(w), 0) + kTorusr * n;
@@ -118,20 +107,7 @@ class AnalyticTruth final : public Truth {
         n[axis] = q[axis] > 0 ? 1 : -1;
         break;
       }
-      default: {  // cylinder
-        const double side = 2 * kPi * kCylR * 2 * kCylH, cap = kPi * kCylR * kCylR;
-        const double phi = 2 * kPi * u(1);
-        if (u(0) * (side + 2 * cap) < side) {
-          n = Vec3(std::cos(phi), std::sin(phi), 0);
-          q = Vec3(kCylR * n.x(), kCylR * n.y(), (2 * u(2) - 1) * kCylH);
-        } else {
-          const double r = kCylR * std::sqrt(u(2));
-          const double z = u(3) < 0.5 ? -kCylH : kCylH;
-          q = Vec3(r * std::cos(phi), r * std::sin(phi), z);
-          n = Vec3(0, 0, z > 0 ? 1 : -1);
-        }
-        break;
-      }
+      default: sample_cylinder(seed, index, u, q, n); break;
     }
     return {t_ + A_ * q, (N_ * n).normalized()};
   }
@@ -149,9 +125,8 @@ class AnalyticTruth final : public Truth {
         break;
       }
       default: {
-        // Side, caps and the two outer quarter tori (Pappus) of the shrunk cylinder r, h.
-        const double f = fillet_, r = kCylR - f, h = kCylH - f;
-        a = 2 * kPi * kCylR * 2 * h + 2 * kPi * r * r + 2 * (2 * kPi * f * (kPi / 2 * r + f));
+        const CylinderParts p = cylinder_parts();
+        a = p.side + 2 * p.cap + 2 * p.rim;
         break;
       }
     }
@@ -242,14 +217,37 @@ class AnalyticTruth final : public Truth {
     }
   }
 
-  // The filleted cylinder (the shrunk cylinder r, h plus a ball of radius
-  // f), uniform by area: the side, a cap's disc or a rim's outer quarter
-  // torus, by their areas. On a rim, theta (0: outwards, pi/2: up) has
-  // density (r + f cos theta): rejection from a sub-stream, as the torus.
-  template <class U>
-  void sample_filleted_cylinder(uint64_t seed, uint64_t index, const U& u, Vec3& q, Vec3& n) const {
+  // An angle in [0, span) with density R + r cos(angle): rejection sampling
+  // from a sub-stream of this index (the torus: acceptance 1/1.4; 64 tries
+  // never all fail in practice, and the last one is taken if they do).
+  static double cosine_weighted(uint64_t stream, uint64_t index, double span, double R, double r) {
+    double a = 0;
+    for (uint64_t k = 0; k < 64; ++k) {
+      a = span * detail::uniform(stream, 128 * index + 2 * k);
+      if (detail::uniform(stream, 128 * index + 2 * k + 1) * (R + r) <= R + r * std::cos(a)) break;
+    }
+    return a;
+  }
+
+  // The (filleted) cylinder's areas, model units: its side, one cap's disc
+  // and one rim's outer quarter torus (Pappus) of the shrunk cylinder r, h
+  // (a sharp cylinder: no rim).
+  struct CylinderParts {
+    double side, cap, rim;
+  };
+  CylinderParts cylinder_parts() const {
     const double f = fillet_, r = kCylR - f, h = kCylH - f;
-    const double side = 2 * kPi * kCylR * 2 * h, cap = kPi * r * r, rim = 2 * kPi * f * (kPi / 2 * r + f);
+    return {2 * kPi * kCylR * 2 * h, kPi * r * r, 2 * kPi * f * (kPi / 2 * r + f)};
+  }
+
+  // The cylinder, sharp or filleted (the shrunk cylinder r, h plus a ball
+  // of radius f), uniform by area: the side, a cap's disc or a rim's outer
+  // quarter torus (none when sharp), by their areas. On a rim, theta (0:
+  // outwards, pi/2: up) has density (r + f cos theta): cosine_weighted.
+  template <class U>
+  void sample_cylinder(uint64_t seed, uint64_t index, const U& u, Vec3& q, Vec3& n) const {
+    const double f = fillet_, r = kCylR - f, h = kCylH - f;
+    const auto [side, cap, rim] = cylinder_parts();
     const double phi = 2 * kPi * u(1);
     const Vec3 dir(std::cos(phi), std::sin(phi), 0);
     const double up = u(3) < 0.5 ? -1 : 1;
@@ -262,11 +260,7 @@ class AnalyticTruth final : public Truth {
       q = Vec3(rho * dir.x(), rho * dir.y(), up * kCylH);
       n = Vec3(0, 0, up);
     } else {
-      double th = 0;
-      for (uint64_t k = 0; k < 64; ++k) {
-        th = kPi / 2 * detail::uniform(seed ^ 0x7f4a7c15u, 128 * index + 2 * k);
-        if (detail::uniform(seed ^ 0x7f4a7c15u, 128 * index + 2 * k + 1) * (r + f) <= r + f * std::cos(th)) break;
-      }
+      const double th = cosine_weighted(seed ^ 0x7f4a7c15u, index, kPi / 2, r, f);
       n = Vec3(std::cos(th) * dir.x(), std::cos(th) * dir.y(), up * std::sin(th));
       q = Vec3(r * dir.x(), r * dir.y(), up * h) + f * n;
     }
