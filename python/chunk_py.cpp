@@ -48,6 +48,8 @@ py::dict to_dict(const SurfacePiece& piece) {
   d["code"] = to_numpy(piece.code);
   d["t"] = to_numpy(piece.t);
   d["triangles"] = to_numpy(piece.triangles);
+  d["velocity"] = to_numpy(piece.velocity);
+  d["residuals"] = to_numpy(piece.residuals);
   d["iterations"] = piece.press.iterations;
   return d;
 }
@@ -64,8 +66,11 @@ SurfacePiece from_dict(const py::dict& d) {
   p.t = from_numpy<double>(d, "t");
   p.triangles = from_numpy<uint64_t>(d, "triangles");
   if (d.contains("iterations")) p.press.iterations = d["iterations"].cast<int>();
-  if (p.code.size() != p.sticks.size() || p.t.size() != p.sticks.size() || p.triangles.size() % 3)
-    throw UsageError("a piece's arrays do not match (sticks, code, t, triangles)");
+  if (d.contains("velocity")) p.velocity = from_numpy<double>(d, "velocity");
+  if (d.contains("residuals")) p.residuals = from_numpy<double>(d, "residuals");
+  if (p.code.size() != p.sticks.size() || p.t.size() != p.sticks.size() || p.triangles.size() % 3 ||
+      (!p.velocity.empty() && p.velocity.size() != p.sticks.size()))
+    throw UsageError("a piece's arrays do not match (sticks, code, t, velocity, triangles)");
   return p;
 }
 
@@ -89,39 +94,97 @@ py::list py_chunk_plan(const py::handle& shape, int64_t chunk, int64_t halo) {
   return out;
 }
 
+// One block of a plan, as the Dask task reads it: the whole lattice, the
+// grid, the block's samples (its read box, non-zero inside) and the options
+// chunk_surface_options gives (levels from the inside box `bounds`).
+struct BlockTask {
+  Lattice lattice;
+  ChunkGrid grid;
+  SurfaceOptions so;
+  BinaryVolume samples;
+  BlockTask(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
+            const py::tuple& bounds, const py::object& spacing, const py::object& origin, const py::object& direction,
+            const py::kwargs& kw)
+      : lattice(whole_lattice(shape, spacing, origin, direction)), grid(lattice.dims, ChunkOptions{chunk, halo}) {
+    SurfaceOptions o;
+    set_options(o, kw);
+    if (block >= grid.count()) throw UsageError("block " + std::to_string(block) + " is not in the plan");
+    if (bounds.size() != 2) throw UsageError("bounds must be (lo, hi): the box of the inside samples");
+    VolumeSummary summary;
+    summary.bounds = {corner(bounds[0], "bounds lo"), corner(bounds[1], "bounds hi")};
+    so = chunk_surface_options(o, summary);
+    const Box box = grid.with_halo(block);
+    ScalarVolume scalar = to_volume(mask, py::make_tuple(1, 1, 1), py::make_tuple(0, 0, 0), py::none(), "xyz");
+    if (scalar.lattice.dims != box.dims())
+      throw UsageError("block " + std::to_string(block) + " must be the array's box read = (lo, hi) of chunk_plan");
+    Selection nonzero;
+    nonzero.kind = Selection::Kind::nonzero;
+    samples = select_samples(scalar, nonzero);
+    samples.lattice = box_lattice(lattice, box);
+    samples.source = "array";
+  }
+};
+
+// f() on `threads` cores (a Dask worker's share of the machine; 0: all), without the GIL.
+template <class F>
+SurfacePiece on_cores(int threads, F&& f) {
+  SurfacePiece piece;
+  py::gil_scoped_release release;
+  if (threads > 0) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] { piece = f(); });
+  } else {
+    piece = f();
+  }
+  return piece;
+}
+
+PressState state_of(const py::list& pieces) {
+  std::vector<SurfacePiece> ps;
+  for (const py::handle& h : pieces) ps.push_back(from_dict(h.cast<py::dict>()));
+  py::gil_scoped_release release;
+  return press_state(ps);
+}
+
 py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
                         const py::tuple& bounds, const py::object& spacing, const py::object& origin,
                         const py::object& direction, int threads, const py::kwargs& kw) {
+  const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
+  return to_dict(on_cores(threads, [&] { return press_block(task.samples, task.grid, block); }));
+}
+
+py::dict py_press_round(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
+                        const py::tuple& bounds, const py::object& spacing, const py::object& origin,
+                        const py::object& direction, int threads, int first, int last, const py::list& state,
+                        const py::kwargs& kw) {
+  const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
+  const PressState st = state_of(state);
+  return to_dict(on_cores(threads, [&] {
+    return press_block_round(task.samples, task.grid, block, task.so, PressRound{first, last}, st);
+  }));
+}
+
+py::dict py_finish_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
+                         const py::tuple& bounds, const py::object& spacing, const py::object& origin,
+                         const py::object& direction, int threads, const py::list& state, bool measure,
+                         const py::kwargs& kw) {
+  const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
+  const PressState st = state_of(state);
+  return to_dict(on_cores(threads, [&] { return finish_block(task.samples, task.grid, block, task.so, st, measure); }));
+}
+
+py::list py_press_rounds(const py::handle& shape, int64_t halo, const py::tuple& bounds, const py::object& spacing,
+                         const py::object& origin, const py::object& direction, const py::kwargs& kw) {
+  const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
   SurfaceOptions o;
   set_options(o, kw);
-  const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
-  const ChunkGrid grid(lattice.dims, ChunkOptions{chunk, halo});
-  if (block >= grid.count()) throw UsageError("block " + std::to_string(block) + " is not in the plan");
   if (bounds.size() != 2) throw UsageError("bounds must be (lo, hi): the box of the inside samples");
   VolumeSummary summary;
   summary.bounds = {corner(bounds[0], "bounds lo"), corner(bounds[1], "bounds hi")};
-  const Box box = grid.with_halo(block);
-  ScalarVolume scalar = to_volume(mask, py::make_tuple(1, 1, 1), py::make_tuple(0, 0, 0), py::none(), "xyz");
-  if (scalar.lattice.dims != box.dims())
-    throw UsageError("block " + std::to_string(block) + " must be the array's box read = (lo, hi) of chunk_plan");
-  SurfacePiece piece;
-  {
-    py::gil_scoped_release release;
-    Selection nonzero;
-    nonzero.kind = Selection::Kind::nonzero;
-    BinaryVolume b = select_samples(scalar, nonzero);
-    b.lattice = box_lattice(lattice, box);
-    b.source = "array";
-    const SurfaceOptions so = chunk_surface_options(o, summary);
-    const SurfaceOptions* pressed = halo > 0 ? &so : nullptr;  // halo 0: extraction only (exact mode)
-    if (threads > 0) {  // a Dask worker's share of the machine
-      tbb::task_arena arena(threads);
-      arena.execute([&] { piece = press_block(b, grid, block, pressed); });
-    } else {
-      piece = press_block(b, grid, block, pressed);
-    }
-  }
-  return to_dict(piece);
+  py::list out;
+  for (const PressRound& r : press_rounds(lattice, chunk_surface_options(o, summary), halo))
+    out.append(py::make_tuple(r.first, r.last));
+  return out;
 }
 
 py::dict py_merge(const py::list& pieces, const py::handle& shape) {
@@ -353,7 +416,22 @@ void bind_chunks(py::module_& m) {
   m.def("_press_block", &py_press_block, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
         py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
         py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
-        "One block's piece (voxpress.dask): mask is the block's read box, non-zero inside; threads 0: all cores.");
+        "One block's piece, extracted (voxpress.dask): mask is the block's read box, non-zero inside; threads 0: all "
+        "cores.");
+  m.def("_press_rounds", &py_press_rounds, py::arg("shape"), py::kw_only(), py::arg("halo"), py::arg("bounds"),
+        py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
+        py::arg("direction") = py::none(),
+        "The halo mode's rounds [(first, last)]: sweeps of the whole run between exchanges (press_rounds).");
+  m.def("_press_round", &py_press_round, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
+        py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
+        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
+        py::arg("first"), py::arg("last"), py::arg("state"),
+        "One block's round: sweeps [first, last) from the state of the pieces of the last round around it.");
+  m.def("_finish_block", &py_finish_block, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
+        py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
+        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
+        py::arg("state"), py::arg("measure") = true,
+        "One block's last step after the rounds: the residual at the final t, the quadric fit, its piece.");
   m.def("_merge", &py_merge, py::arg("pieces"), py::kw_only(), py::arg("shape"),
         "One piece of consecutive ones (each one's blocks follow the one before): a step of voxpress.dask's tree "
         "reduction.");

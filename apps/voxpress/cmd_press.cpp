@@ -259,7 +259,8 @@ void run_press(const PressCmd& c, const Global& g) {
     if (p.chunks)
       std::fprintf(stderr, "%s: %zu blocks of %lld, %s; %s\n", c.output.c_str(), p.chunks->blocks,
                    (long long)c.chunks.chunk,
-                   c.chunks.halo ? ("pressed apart with a halo of " + std::to_string(c.chunks.halo)).c_str()
+                   c.chunks.halo ? ("pressed apart with a halo of " + std::to_string(c.chunks.halo) + " in " +
+                                   std::to_string(p.chunks->rounds) + " rounds").c_str()
                                  : "stitched and smoothed whole (exact)",
                    p.streamed ? "read from disk block by block" : "the file was read whole (only raw NRRD and .raw stream)");
   }
@@ -268,7 +269,7 @@ void run_press(const PressCmd& c, const Global& g) {
     j["method"] = c.method;
     if (const auto& st = p.chunks)
       j["chunks"] = {{"chunk", c.chunks.chunk}, {"halo", c.chunks.halo}, {"blocks", st->blocks},
-                     {"blocks_with_surface", st->pressed}, {"streamed", p.streamed},
+                     {"blocks_with_surface", st->pressed}, {"rounds", st->rounds}, {"streamed", p.streamed},
                      {"seconds", {{"summary", st->seconds_summary}, {"blocks", st->seconds_blocks},
                                   {"stitch", st->seconds_stitch}}}};
     if (pressing) {
@@ -362,8 +363,9 @@ void register_press(CLI::App& app, Global& g) {
                  "shared surface of every label, from the blocks)")
       ->check(CLI::Range(int64_t(8), int64_t(1) << 20));
   ch->add_option("--halo", c->chunks.halo,
-                 "Also press each block apart, reading this many samples around it (memory: one block's surface; "
-                 "Pressing only, no flats; vertices near block borders move, docs/BENCHMARKS.md)")
+                 "Also press each block apart, reading this many samples around it, in rounds that exchange the "
+                 "blocks' borders (what Dask workers do; Pressing only, no flats): the whole run's surface up to "
+                 "rounding; wider: fewer rounds; too narrow for one sweep: refused, naming the smallest")
       ->check(CLI::Range(int64_t(1), int64_t(256)));
   bind_simplify(*cmd, c->simplify);
   cmd->add_flag("--ascii", c->ascii, "ASCII PLY instead of binary");

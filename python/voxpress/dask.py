@@ -9,7 +9,9 @@
 
 The volume is cut into blocks of `chunk` samples per side (voxpress.chunk_plan).
 Each block, read with `halo` more samples on every side, is one Dask task
-(voxpress._press_block, run on a worker) returning its piece of the surface:
+(voxpress._press_block, run on a worker; with a halo, one per round of
+sweeps, voxpress._press_round, then voxpress._finish_block) returning its
+piece of the surface:
 numpy arrays of global stick keys, codes, pressed positions and triangles,
 which pickle compactly. Consecutive pieces merge on the workers, up to
 split_every at a time (a tree reduction, voxpress._merge), and the caller
@@ -48,6 +50,52 @@ def _merge(*pieces, **kw):  # a module function pickles by name; the binding its
     return _voxpress._merge(list(pieces), **kw)
 
 
+def _round(mask, state, **kw):
+    return _voxpress._press_round(np.asarray(mask), state=list(state), **kw)
+
+
+def _finish(mask, state, **kw):
+    return _voxpress._finish_block(np.asarray(mask), state=list(state), **kw)
+
+
+def _sweep_residuals(*pieces):
+    """The whole run's residual per sweep of a round: the max over its blocks (NaN before the last stage)."""
+    rows = [p["residuals"] for p in pieces if len(p["residuals"])]
+    if not rows:
+        return np.zeros(0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns: sweeps before the last stage
+        return np.nanmax(np.vstack(rows), axis=0)
+
+
+def _halo_tasks(plan, inside, rounds, measure, common, options):
+    """The halo mode's graph: one task per block per round, each reading the
+    pieces of the blocks whose core meets its read box from the round
+    before, then each block's last step; and per round, the residual per sweep."""
+    import dask
+
+    def meets(core, read):
+        return all(core[0][a] < read[1][a] and read[0][a] < core[1][a] for a in range(3))
+
+    around = [[c["block"] for c in plan if meets(c["core"], b["read"])] for b in plan]
+    masks = []
+    for b in plan:
+        (x0, y0, z0), (x1, y1, z1) = b["read"]
+        masks.append(inside[x0:x1, y0:y1, z0:z1])
+    step, finish, sweeps = dask.delayed(_round, pure=True), dask.delayed(_finish, pure=True), \
+        dask.delayed(_sweep_residuals, pure=True)
+    last, residuals = None, []
+    for first, end in rounds:
+        state = [[] if last is None else [last[c] for c in around[b["block"]]] for b in plan]
+        last = [step(masks[i], state[i], block=b["block"], first=first, last=end, **common, **options)
+                for i, b in enumerate(plan)]
+        residuals.append(sweeps(*last))
+    state = [[] if last is None else [last[c] for c in around[b["block"]]] for b in plan]
+    done = [finish(masks[i], state[i], block=b["block"], measure=measure, **common, **options)
+            for i, b in enumerate(plan)]
+    return done, residuals
+
+
 def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
           label=None, threshold=None, client=None, threads=0, split_every=16, **options):
     """The smooth surface of a Dask, Zarr or numpy array, block by block on Dask; returns a Mesh.
@@ -60,8 +108,10 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
     smooths the stitched surface: `voxpress press` byte for byte, flats and
     sharp edges included; the caller holds the surface, never the volume.
     halo=H: the workers press their blocks too, reading H samples around
-    them (`press --chunk N --halo H`): no process holds more than a block's
-    surface; Pressing only (flats off); vertices near block borders move
+    them, in rounds that exchange the blocks' borders (`press --chunk N
+    --halo H`): no process holds more than a block's surface; Pressing only
+    (flats off); the whole run's surface up to rounding (stats iterations
+    and residual as press()'s); the wider the halo, the fewer the rounds
     (docs/BENCHMARKS.md, Chunked). client: a dask.distributed Client; None
     uses Dask's current scheduler (a Client you created, else threads).
     threads: cores one block task uses (0: all its machine's; set it to the
@@ -97,25 +147,54 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
     hi = [int(np.flatnonzero(c)[-1]) + 1 for c in counts]
     options = {k: v for k, v in options.items() if v is not None}
     plan = _voxpress.chunk_plan(shape, chunk=chunk, halo=halo)
-    block = dask.delayed(_block, pure=True)
-    tasks = []
-    for b in plan:
-        (x0, y0, z0), (x1, y1, z1) = b["read"]
-        tasks.append(block(inside[x0:x1, y0:y1, z0:z1], shape=shape, block=b["block"], chunk=chunk, halo=halo,
-                           bounds=(lo, hi), spacing=spacing, origin=origin, direction=direction, threads=threads,
-                           **(options if halo else {})))
+    common = dict(shape=shape, chunk=chunk, halo=halo, bounds=(lo, hi), spacing=spacing, origin=origin,
+                  direction=direction, threads=threads)
+
+    def compute(*graphs):
+        return list(client.gather(client.compute(list(graphs)))) if client is not None else list(dask.compute(*graphs))
+
+    pressed = {}
+    if halo:
+        # Rounds of sweeps between exchanges (voxpress/chunk/chunked.h): the
+        # whole run's surface. Where the whole run would stop (the first
+        # sweep of its last stage whose residual is within the tolerance),
+        # the graph is built again up to that sweep.
+        rounds = [tuple(r) for r in _voxpress._press_rounds(shape, halo=halo, bounds=(lo, hi), spacing=spacing,
+                                                            origin=origin, direction=direction, **options)]
+        if len(plan) == 1:
+            rounds = [(rounds[0][0], rounds[-1][1])] if rounds else []
+        tolerance = options.get("tolerance", 1e-4)
+        tasks, residuals = _halo_tasks(plan, inside, rounds, True, common, options)
+        out = compute(*tasks, *residuals)
+        tasks, residuals = out[:len(tasks)], out[len(tasks):]
+        sweep = [(r[0] + k, v) for r, row in zip(rounds, residuals) for k, v in enumerate(row) if not np.isnan(v)]
+        stop = next(((k, v) for k, v in sweep if v <= tolerance), None)
+        if stop is not None:
+            cut = [(a, min(b, stop[0])) for a, b in rounds if a < stop[0]]
+            tasks = compute(*_halo_tasks(plan, inside, cut, False, common, options)[0])
+            pressed = {"iterations": stop[0], "residual": stop[1]}
+        else:
+            final = max((p["residuals"][0] for p in tasks if len(p["residuals"])), default=0.0)
+            pressed = {"iterations": rounds[-1][1] if rounds else 0, "residual": float(final)}
+        tasks = [dask.delayed(p) for p in tasks]
+    else:
+        block = dask.delayed(_block, pure=True)
+        tasks = []
+        for b in plan:
+            (x0, y0, z0), (x1, y1, z1) = b["read"]
+            tasks.append(block(inside[x0:x1, y0:y1, z0:z1], block=b["block"], **common))
     # Tree reduction: up to split_every consecutive pieces merge on a worker
     # (a k-way merge in whole-run order), level after level, until the
     # caller has at most split_every of them to stitch.
     merge = dask.delayed(_merge, pure=True)
     while len(tasks) > split_every:
         tasks = [merge(*tasks[i:i + split_every], shape=shape) for i in range(0, len(tasks), split_every)]
-    if client is not None:
-        pieces = client.gather(client.compute(tasks))
-    else:
-        pieces = list(dask.compute(*tasks))
-    return _voxpress._stitch(pieces, shape=shape, spacing=spacing, origin=origin, direction=direction,
+    pieces = list(compute(*tasks))
+    mesh = _voxpress._stitch(pieces, shape=shape, spacing=spacing, origin=origin, direction=direction,
                              smooth=not halo, **(options if not halo else {}))
+    for key, value in pressed.items():
+        mesh.stats[key] = value
+    return mesh
 
 
 def _label_block(samples, **kw):

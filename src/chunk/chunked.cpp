@@ -14,6 +14,7 @@
 #include "core/timing.h"
 #include "voxpress/core/error.h"
 #include "core/parallel.h"
+#include "chunk/block.h"
 
 namespace voxpress {
 
@@ -130,55 +131,64 @@ SurfaceOptions chunk_surface_options(const SurfaceOptions& options, const Volume
   return o;
 }
 
-SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_t b, const SurfaceOptions* options) {
-  const Box read = grid.with_halo(b), core = grid.core(b);
+detail::BlockSticks detail::block_sticks(const BinaryVolume& block, const ChunkGrid& grid, size_t b,
+                                         const ExtractOptions& eo) {
+  const Box read = grid.with_halo(b);
   const auto& dims = grid.dims;
   if (block.lattice.dims != read.dims() || block.inside.size() != read.size())
     throw UsageError("press_block: the samples do not match block " + std::to_string(b) + "'s box with its halo");
-  SurfacePiece out;
-  out.block = b;
-  out.blocks = grid.count();
+  BlockSticks out;
+  out.offset = read.lo;
   const uint64_t inside = block.count_inside();
   if (inside == 0) return out;
   bool touches_border = false;
   for (size_t a = 0; a < 3; ++a) touches_border |= read.lo[a] == 0 || read.hi[a] == dims[a];
   if (inside == block.lattice.size() && !touches_border) return out;  // its only sticks are the read box's faces
-
-  StickSurface s = extract_sticks(block, options ? options->extract : ExtractOptions{});
-  if (options) {
-    SurfaceResult r;
-    press_stick_surface(s, *options, r);
-    out.press = r.press;
-  }
-
-  auto global_lower = [&](size_t id) {
-    auto l = s.lower_index(id);
+  out.s = extract_sticks(block, eo);
+  const Box core = grid.core(b);
+  const size_t n = out.s.stick_count();
+  out.key.resize(n);
+  out.owned.resize(n);
+  detail::parallel_for(n, [&](size_t id) {
+    auto l = out.s.lower_index(id);
     for (size_t a = 0; a < 3; ++a) l[a] += read.lo[a];
-    return l;
-  };
-  auto key_of = [&](size_t id) {
-    auto l = global_lower(id);
+    out.owned[id] = in_core(core, dims, l);
     for (int64_t& x : l) x += 1;
-    return stick_key(dims, l, s.axis(id));
-  };
+    out.key[id] = stick_key(dims, l, out.s.axis(id));
+  });
+  return out;
+}
+
+SurfacePiece detail::owned_piece(const BlockSticks& bs, const ChunkGrid& grid, size_t b, bool triangles) {
+  SurfacePiece out;
+  out.block = b;
+  out.blocks = grid.count();
+  const StickSurface& s = bs.s;
   for (size_t id = 0; id < s.stick_count(); ++id)
-    if (in_core(core, dims, global_lower(id))) {
-      out.sticks.push_back(key_of(id));
+    if (bs.owned[id]) {
+      out.sticks.push_back(bs.key[id]);
       out.code.push_back(s.code[id]);
       out.t.push_back(s.t[id]);
     }
+  if (!triangles) return out;
   // A triangle's cube is the componentwise minimum of its three sticks' lower
   // samples (no cube case has a triangle on one face: tests/chunk).
+  const Box core = grid.core(b);
   for (const Triangle& tri : s.triangles) {
     std::array<int64_t, 3> corner{INT64_MAX, INT64_MAX, INT64_MAX};
     for (uint32_t v : tri) {
-      const auto l = global_lower(v);
-      for (size_t a = 0; a < 3; ++a) corner[a] = std::min(corner[a], l[a]);
+      const auto l = s.lower_index(v);
+      for (size_t a = 0; a < 3; ++a) corner[a] = std::min(corner[a], l[a] + bs.offset[a]);
     }
-    if (!in_core(core, dims, corner)) continue;
-    for (uint32_t v : tri) out.triangles.push_back(key_of(v));
+    if (!in_core(core, grid.dims, corner)) continue;
+    for (uint32_t v : tri) out.triangles.push_back(bs.key[v]);
   }
   return out;
+}
+
+SurfacePiece press_block(const BinaryVolume& block, const ChunkGrid& grid, size_t b) {
+  const detail::BlockSticks bs = detail::block_sticks(block, grid, b, ExtractOptions{});
+  return detail::owned_piece(bs, grid, b, true);
 }
 
 namespace {
@@ -338,6 +348,77 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
   return out;
 }
 
+namespace {
+
+// The halo mode (press_rounds): every block runs each round from the state
+// the last one left, then its final step. The whole run stops at the first
+// sweep of the last stage whose residual (max over all sticks) is within
+// the tolerance, before applying it: the round holding that sweep is run
+// again up to it. Returns the whole run's PressStats (iterations, residual).
+template <class BlockOf>
+PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const SurfaceOptions& so, BlockOf block_of,
+                           std::vector<SurfacePiece>& pieces, Progress* progress_sink, int& round_count) {
+  // One block has no artificial border (its box is the volume's): one round.
+  const std::vector<PressRound> rounds = press_rounds(lattice, so, grid.count() == 1 ? INT32_MAX : grid.halo);
+  const size_t nb = grid.count();
+  ProgressCounter progress(progress_sink, "rounds", uint64_t((rounds.size() + 1) * nb));
+  PressStats st;
+  st.levels = so.press.levels;
+  const auto run_round = [&](const PressRound& r, const PressState& state) {
+    detail::parallel_ranges(nb, 1, [&](detail::IndexRange range) {
+      for (size_t b = range.begin(); b < range.end(); ++b) {
+        pieces[b] = press_block_round(block_of(b), grid, b, so, r, state);
+        progress.add(1);
+      }
+    });
+  };
+  PressState state;
+  bool stopped = false, any = false;
+  round_count = 0;
+  for (const PressRound& r : rounds) {
+    run_round(r, state);
+    ++round_count;
+    // The whole run's residual per sweep: the max over the blocks (NaN before the last stage).
+    int stop = -1;
+    for (int k = 0; k < r.last - r.first && stop < 0; ++k) {
+      double res = std::nan("");
+      for (const SurfacePiece& p : pieces)
+        if (size_t(k) < p.residuals.size() && !std::isnan(p.residuals[size_t(k)]))
+          res = std::isnan(res) ? p.residuals[size_t(k)] : std::max(res, p.residuals[size_t(k)]);
+      if (std::isnan(res)) continue;
+      st.residual = res;
+      st.least_residual = any ? std::min(st.least_residual, res) : res;
+      any = true;
+      if (res <= so.press.tolerance) stop = r.first + k;
+    }
+    if (stop >= 0) {  // the whole run stops before sweep `stop`: this round again, up to it
+      if (stop > r.first) run_round({r.first, stop}, state), ++round_count;
+      st.iterations = stop;
+      stopped = true;
+    } else {
+      st.iterations = r.last;
+    }
+    if (!stopped || st.iterations > r.first) state = press_state(pieces);  // stopped at the round's start: the state before it
+    if (stopped) break;
+  }
+  detail::parallel_ranges(nb, 1, [&](detail::IndexRange range) {
+    for (size_t b = range.begin(); b < range.end(); ++b) {
+      pieces[b] = finish_block(block_of(b), grid, b, so, state, !stopped);
+      progress.add(1);
+    }
+  });
+  if (!stopped) {  // the cap ended it: the residual at the final t
+    double res = 0;
+    for (const SurfacePiece& p : pieces)
+      if (!p.residuals.empty()) res = std::max(res, p.residuals[0]);
+    st.residual = res;
+    st.least_residual = any ? std::min(st.least_residual, res) : res;
+  }
+  return st;
+}
+
+}  // namespace
+
 SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, const BlockReader& read,
                             const SurfaceOptions& options, const ChunkOptions& chunks, ChunkedStats* stats) {
   const bool exact = chunks.halo == 0;
@@ -375,27 +456,31 @@ SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, c
 
   t0 = std::chrono::steady_clock::now();
   const SurfaceOptions so = chunk_surface_options(options, summary);
-  if (!exact) st.levels = so.press.levels;
+  const auto block_of = [&](size_t b) {
+    const Box box = grid.with_halo(b);
+    BinaryVolume block = read(box);
+    if (block.lattice.dims != box.dims() || block.inside.size() != box.size())
+      throw std::logic_error("press_chunked: the reader returned the wrong box");
+    block.lattice = box_lattice(lattice, box);
+    block.source = source;
+    return block;
+  };
   std::vector<SurfacePiece> pieces(grid.count());
-  {
+  PressStats pressed;
+  if (exact) {
     ProgressCounter progress(options.progress, "blocks", grid.count());
     detail::parallel_ranges(grid.count(), 1, [&](detail::IndexRange r) {
       for (size_t b = r.begin(); b < r.end(); ++b) {
-        const Box box = grid.with_halo(b);
-        BinaryVolume block = read(box);
-        if (block.lattice.dims != box.dims() || block.inside.size() != box.size())
-          throw std::logic_error("press_chunked: the reader returned the wrong box");
-        block.lattice = box_lattice(lattice, box);
-        block.source = source;
-        pieces[b] = press_block(block, grid, b, exact ? nullptr : &so);
+        pieces[b] = press_block(block_of(b), grid, b);
         progress.add(1);
       }
     });
+  } else {
+    st.levels = so.press.levels;
+    pressed = press_in_rounds(lattice, grid, so, block_of, pieces, options.progress, st.rounds);
   }
-  for (const SurfacePiece& p : pieces) {
-    st.pressed += p.press.iterations > 0 || !p.sticks.empty();
-    st.max_iterations = std::max(st.max_iterations, p.press.iterations);
-  }
+  for (const SurfacePiece& p : pieces) st.pressed += !p.sticks.empty();
+  st.max_iterations = pressed.iterations;
   st.seconds_blocks = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
@@ -423,8 +508,7 @@ SurfaceResult press_chunked(const Lattice& lattice, const std::string& source, c
     st.max_iterations = r.press.iterations;
   } else {
     r.mesh = to_mesh(surface);
-    r.press.iterations = st.max_iterations;
-    r.press.levels = st.levels;
+    r.press = pressed;
     simplify_result(lattice, options, r);
   }
   if (stats) *stats = st;

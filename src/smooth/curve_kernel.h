@@ -257,8 +257,25 @@ void make_layout(const StickSurface& s, const SliceCurves& curves, Layout& out);
 PressStats press_on(StickSurface& s, const Layout& L, const PressOptions& o, const std::vector<uint8_t>& frozen = {},
                     const std::vector<uint8_t>& barrier = {});
 
+/// Sweeps [first, last) of the schedule iterate() runs with the same
+/// options (the stage of sweep k is the whole run's), from a given momentum
+/// state: what a block pressed with a halo runs between exchanges of its
+/// border (chunk/rounds.cpp). No residual ends it: the caller decides on
+/// every block's residuals, so the result is the whole run's sweeps.
+struct SweepWindow {
+  int first = 0, last = 0;
+  std::vector<double>* velocity = nullptr;  ///< in and out, one per vertex (momentum 0: unused)
+  const std::vector<uint8_t>* counted = nullptr;  ///< the vertices whose residual counts (null: all)
+  /// Out: per sweep of the window, the residual over the counted vertices
+  /// when the sweep is in the last stage (NaN before it).
+  std::vector<double> residuals;
+};
 PressStats iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
                    const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier, const PressOptions& o,
-                   int levels);
+                   int levels, SweepWindow* window = nullptr);
+/// The residual max |T(t) - t| of the map at d over the counted vertices
+/// (null: all fresh ones).
+double residual_at(const std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
+                   const PressOptions& o, const std::vector<uint8_t>* counted);
 
 }  // namespace voxpress::detail

@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/timing.h"
@@ -199,14 +200,16 @@ void Sweeper::family(const Family& fam, const std::vector<double>& x, double sca
   });
 }
 
-// max over the fresh vertices of |T(t)_i - t_i|, T(t) = clamp(t + step).
+// max over the fresh vertices (of those `counted`, when given) of
+// |T(t)_i - t_i|, T(t) = clamp(t + step).
 double residual_of(const std::vector<double>& t, const std::vector<double>& step, const std::vector<uint8_t>& frozen,
-                   double lo, double hi) {
+                   double lo, double hi, const std::vector<uint8_t>* counted = nullptr) {
   return tbb::parallel_reduce(
       tbb::blocked_range<size_t>(0, t.size(), 1 << 14), 0.0,
       [&](const tbb::blocked_range<size_t>& r, double acc) {
         for (size_t i = r.begin(); i < r.end(); ++i)
-          if (frozen.empty() || !frozen[i]) acc = std::max(acc, std::abs(std::clamp(t[i] + step[i], lo, hi) - t[i]));
+          if ((frozen.empty() || !frozen[i]) && (!counted || (*counted)[i]))
+            acc = std::max(acc, std::abs(std::clamp(t[i] + step[i], lo, hi) - t[i]));
         return acc;
       },
       [](double a, double b) { return std::max(a, b); });
@@ -214,9 +217,19 @@ double residual_of(const std::vector<double>& t, const std::vector<double>& step
 
 }  // namespace
 
+double detail::residual_at(const std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
+                          const PressOptions& o, const std::vector<uint8_t>* counted) {
+  if (t.empty()) return 0;
+  const std::vector<uint8_t> none;  // no frozen vertex, no barrier (the Sweeper holds references)
+  Sweeper sweep(families, per_vertex, none, none, o, t.size());
+  std::vector<double> step(t.size());
+  sweep(t, 1, step);
+  return residual_of(t, step, {}, o.margin, 1 - o.margin, counted);
+}
+
 PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& families, int per_vertex,
                            const std::vector<uint8_t>& frozen, const std::vector<uint8_t>& barrier,
-                           const PressOptions& o, int levels) {
+                           const PressOptions& o, int levels, SweepWindow* window) {
   const auto t0 = std::chrono::steady_clock::now();
   const size_t n = t.size();
   PressStats st;
@@ -227,21 +240,28 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
   if (n == 0 || st.fresh == 0) return st;
   Sweeper sweep(families, per_vertex, frozen, barrier, o, n);
   std::vector<double> step(n);
-  std::vector<double> velocity(o.momentum != 0 ? n : 0, 0.0);
+  std::vector<double> own_velocity;
+  std::vector<double>& velocity = window && window->velocity ? *window->velocity : own_velocity;
+  if (o.momentum == 0) velocity.clear();
+  else if (velocity.size() != n) velocity.assign(n, 0.0);
   const double lo = o.margin, hi = 1 - o.margin;
   const int cap = std::max(o.iterations, 0);
-  ProgressCounter progress(o.progress, "pressing", uint64_t(cap));
+  const int first = window ? std::clamp(window->first, 0, cap) : 0;
+  const int last = window ? std::clamp(window->last, first, cap) : cap;
+  if (window) window->residuals.assign(size_t(last - first), std::numeric_limits<double>::quiet_NaN());
+  ProgressCounter progress(o.progress, "pressing", uint64_t(last - first));
   bool measured = false;  // st.residual is the residual at the current t
   bool any = false;       // a residual was measured
-  for (int it = 0; it < cap; ++it) {
+  for (int it = first; it < last; ++it) {
     // Stage of the coarse-to-fine schedule: d * 2^(levels - 1 - stage).
     const int stage = std::min(levels - 1, it * levels / std::max(cap, 1));
     sweep(t, double(1 << (levels - 1 - stage)), step);
     if (stage == levels - 1) {  // the map at d: its residual is the stopping rule
-      st.residual = residual_of(t, step, frozen, lo, hi);
+      st.residual = residual_of(t, step, frozen, lo, hi, window ? window->counted : nullptr);
       st.least_residual = any ? std::min(st.least_residual, st.residual) : st.residual;
       any = measured = true;
-      if (st.residual <= o.tolerance) break;
+      if (window) window->residuals[size_t(it - first)] = st.residual;
+      else if (st.residual <= o.tolerance) break;
     }
     detail::parallel_ranges(n, 1 << 14, [&](detail::IndexRange r) {
       for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -256,6 +276,10 @@ PressStats detail::iterate(std::vector<double>& t, const std::vector<Family>& fa
     measured = false;
     st.iterations = it + 1;
     progress.add(1);
+  }
+  if (window) {  // the caller measures where the whole run stops
+    st.seconds = seconds_since(t0);
+    return st;
   }
   if (!measured) {  // the cap ended the solve: the residual at the returned t
     sweep(t, 1, step);

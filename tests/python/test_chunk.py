@@ -20,14 +20,21 @@ def cli(*args):
 def test_chunked_press_is_the_clis(tmp_path):
     vol = tmp_path / "part.nrrd"
     cli("generate", "cad-part", "--res", 40, "--rotate", "random:4", "--spacing", "1,0.9,1.3", "-o", vol)
-    cli("press", vol, "--chunk", 16, "--halo", 5, "-o", tmp_path / "cli.ply")
+    cli("press", vol, "--chunk", 16, "--halo", 14, "-o", tmp_path / "cli.ply")
     data, lattice = voxpress.read_volume(str(vol))
     mesh = voxpress.press(data, spacing=lattice.spacing, origin=lattice.origin, direction=lattice.direction,
-                          chunk=16, halo=5)
+                          chunk=16, halo=14)
     ref = voxpress.read_mesh(str(tmp_path / "cli.ply"))
     np.testing.assert_array_equal(mesh.faces, ref.faces)
     np.testing.assert_array_equal(mesh.vertices, ref.vertices)
-    assert mesh.stats["blocks"] == len(voxpress.chunk_plan(data.shape, chunk=16, halo=5))
+    assert mesh.stats["blocks"] == len(voxpress.chunk_plan(data.shape, chunk=16, halo=14))
+    # Pressed block by block in rounds: the whole run without flats, up to rounding.
+    plain = voxpress.press(data, spacing=lattice.spacing, origin=lattice.origin, direction=lattice.direction,
+                           flats=False)
+    np.testing.assert_array_equal(mesh.faces, plain.faces)
+    np.testing.assert_allclose(mesh.vertices, plain.vertices, rtol=0, atol=1e-9)
+    with pytest.raises(voxpress.UsageError, match="--halo 5"):
+        voxpress.press(data, chunk=16, halo=5)
     assert voxpress.check(mesh, data, spacing=lattice.spacing, origin=lattice.origin,
                           direction=lattice.direction)["ok"]
     # Without a halo (exact): the whole run's bytes, flats and sharp edges included.
@@ -84,10 +91,11 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
     # Blocks pressed on the workers (a halo), the threaded scheduler, a label:
     # the in-process run with the same halo.
     labels = np.where(mask, 3, 0).astype(np.int16)[100:164, 100:164, 20:84]
-    again = voxpress.dask.press(da.from_array(labels, chunks=32), chunk=32, halo=8, label=3, split_every=2)
-    small = voxpress.press(labels == 3, chunk=32, halo=8)
+    again = voxpress.dask.press(da.from_array(labels, chunks=32), chunk=32, halo=12, label=3, split_every=2)
+    small = voxpress.press(labels == 3, chunk=32, halo=12)
     np.testing.assert_array_equal(again.vertices, small.vertices)
     np.testing.assert_array_equal(again.faces, small.faces)
+    assert again.stats["iterations"] == small.stats["iterations"]
     with pytest.raises(voxpress.InputError):
         voxpress.dask.press(da.zeros((32, 32, 32), chunks=16), chunk=16)
     with pytest.raises(voxpress.UsageError):

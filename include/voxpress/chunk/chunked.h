@@ -18,15 +18,22 @@
 // Two modes. Exact (halo 0): blocks are only extracted, and smoothing runs
 // once on the stitched sticks, which is all smooth_surface's stages read:
 // the whole-volume result byte for byte (flats and sharp edges included),
-// with the volume never in memory. Pressing's reach is global (its
-// coarse-to-fine stages move information hundreds of cells, and on a
-// plane nothing stops it), so no halo makes blocks pressed apart exact.
-// Halo (>= 1): each block is pressed on its own too, for surfaces larger
-// than one process (Dask workers); only the t of sticks near block borders
-// differs, by what the halo leaves of the block's artificial border
-// (docs/BENCHMARKS.md, Chunked). Flats are off in that mode (a plane across
-// blocks would need one vote over all of them); levels come from the whole
-// volume's extent, so a block presses with the whole run's stages.
+// with the volume never in memory.
+// Halo (>= 1): the blocks are pressed apart too, for surfaces larger than
+// one process (Dask workers), in rounds. Pressing's reach is global (its
+// coarse-to-fine stages move information hundreds of cells), but one
+// sweep reaches only a few cells: a sweep moves a vertex from the
+// positions within twice its arc length d (times the stage's scale) plus
+// two curve segments along its curves. A round runs as many sweeps of the
+// whole run's schedule as the halo covers (press_rounds), so the block's
+// own sticks see only true neighbours, then the blocks exchange the t and
+// momentum of their sticks (PressState) and the next round starts from
+// them: the whole run's sweeps exactly, up to rounding (positions are taken
+// relative to each block's own box). A last step (finish_block) runs the
+// quadric fit on the final t, whose reach (a dozen rings) the halo must
+// also cover. Flats are off in that mode (a plane across blocks would need
+// one vote over all of them); levels come from the whole volume's extent,
+// so blocks press with the whole run's stages.
 #pragma once
 
 #include <array>
@@ -48,10 +55,11 @@ struct ChunkOptions {
   /// of smooth_surface runs on them (any method, flats and sharp edges too):
   /// the whole-volume result byte for byte, in memory bounded by the surface
   /// and one block, not by the volume.
-  /// >= 1: each block is also pressed on its own, reading this many samples
-  /// beyond it (voxpress.dask's workers): memory bounded by one block's
-  /// surface; Pressing only, flats off; vertices near block borders differ
-  /// from the whole run (per width: docs/BENCHMARKS.md, Chunked).
+  /// >= 1: each block is also pressed apart, reading this many samples
+  /// beyond it, in exchange rounds (voxpress.dask's workers): Pressing only,
+  /// flats off; the whole run's surface up to rounding. The wider the halo,
+  /// the fewer the rounds (press_rounds; too narrow for one sweep of the
+  /// coarsest stage: refused).
   int64_t halo = 0;
 };
 
@@ -83,18 +91,50 @@ struct SurfacePiece {
   std::vector<uint8_t> code;        ///< StickSurface::code of each
   std::vector<double> t;            ///< pressed t of each
   std::vector<uint64_t> triangles;  ///< owned triangles: 3 stick keys each, in whole-run order
+  std::vector<double> velocity;     ///< a round's piece: the momentum of each owned stick
+  /// A round's piece: per sweep of the round, the residual over the owned
+  /// sticks (NaN before the last stage); finish_block's: one, at the final t.
+  std::vector<double> residuals;
   PressStats press;                 ///< the block's Pressing (iterations == 0: nothing to press)
   uint64_t block = 0, blocks = 0;   ///< which block of how many (stitch wants each exactly once)
   uint64_t count = 1;               ///< merged pieces: the blocks [block, block + count)
 };
 
 
-/// Block b's piece of the surface: `samples` holds grid.with_halo(b) (its
-/// lattice's dims must match). With options (as chunk_surface_options
-/// returns them) the block is pressed; without, its sticks keep the
-/// midpoint t (the exact mode's extraction).
-SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b,
-                         const SurfaceOptions* options);
+/// Block b's piece of the surface, extracted: `samples` holds
+/// grid.with_halo(b) (its lattice's dims must match); its sticks keep the
+/// extraction's t (the exact mode).
+SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b);
+
+/// Sweeps [first, last) of the whole run's schedule (PressOptions::iterations).
+struct PressRound {
+  int first = 0, last = 0;
+};
+/// The halo mode's rounds for `options` (as chunk_surface_options returns
+/// them: levels set): each as many sweeps as keep every owned stick beyond
+/// the reach of its block's artificial border. UsageError when the halo is
+/// narrower than the reach of one sweep of the coarsest stage (the message
+/// names the smallest halo).
+std::vector<PressRound> press_rounds(const Lattice& lattice, const SurfaceOptions& options, int64_t halo);
+
+/// Every owned stick's t and momentum between rounds, by key (increasing).
+struct PressState {
+  std::vector<uint64_t> sticks;
+  std::vector<double> t, velocity;
+};
+/// The rounds' pieces (each block once, any order) as one state.
+PressState press_state(const std::vector<SurfacePiece>& pieces);
+
+/// Block b's round: its sticks (owned or in its halo) start from `state`
+/// (empty: the extraction's t, at rest), the round's sweeps run, and the
+/// piece holds the owned sticks' t, momentum and residuals (no triangles).
+SurfacePiece press_block_round(const BinaryVolume& samples, const ChunkGrid& grid, size_t b,
+                               const SurfaceOptions& options, const PressRound& round, const PressState& state);
+/// Block b's last step: its sticks at `state`'s t (after the last round),
+/// the residual there (`residuals`, one value, when `measure`), then the
+/// quadric fit; the piece holds the owned sticks and triangles, for stitch.
+SurfacePiece finish_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options,
+                          const PressState& state, bool measure);
 
 /// One piece of consecutive pieces (each piece's blocks follow the one
 /// before): sticks and triangles merged in whole-run order (k-way), so a
@@ -111,6 +151,7 @@ StickSurface stitch(const Lattice& lattice, const std::vector<SurfacePiece>& pie
 struct ChunkedStats {
   size_t blocks = 0, pressed = 0;  ///< blocks, and those with sticks to press
   int levels = 0, max_iterations = 0;
+  int rounds = 0;                  ///< the halo mode's exchange rounds
   uint64_t sticks = 0, triangles = 0, inside = 0;
   double seconds_summary = 0, seconds_blocks = 0, seconds_stitch = 0;
 };
