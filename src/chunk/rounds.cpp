@@ -51,10 +51,17 @@ struct BlockPress {
   BlockPress(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const PressState& state)
       : bs(detail::block_sticks(samples, grid, b, ExtractOptions{})) {
     const size_t n = bs.s.stick_count();
+    // Where each stick is in the state (SIZE_MAX: not there). A block's
+    // sticks are in whole-run key order (the canonical order of a sub-box),
+    // so one forward search finds them all.
+    std::vector<size_t> at(n, SIZE_MAX);
+    const bool sorted = std::is_sorted(bs.key.begin(), bs.key.end());
+    auto from = state.sticks.begin();
     for (size_t i = 0; i < n; ++i) {
-      const auto it = std::lower_bound(state.sticks.begin(), state.sticks.end(), bs.key[i]);
-      if (it == state.sticks.end() || *it != bs.key[i]) continue;
-      bs.s.t[i] = state.t[size_t(it - state.sticks.begin())];
+      from = std::lower_bound(sorted ? from : state.sticks.begin(), state.sticks.end(), bs.key[i]);
+      if (from == state.sticks.end() || *from != bs.key[i]) continue;
+      at[i] = size_t(from - state.sticks.begin());
+      bs.s.t[i] = state.t[at[i]];
     }
     bs.s = on_own_box(std::move(bs.s), &frame);
     curves = build_slice_curves(bs.s);
@@ -66,9 +73,7 @@ struct BlockPress {
       const uint32_t old = layout.old_of[i];
       t[i] = bs.s.t[old];
       owned[i] = bs.owned[old];
-      const auto it = std::lower_bound(state.sticks.begin(), state.sticks.end(), bs.key[old]);
-      if (it != state.sticks.end() && *it == bs.key[old] && !state.velocity.empty())
-        velocity[i] = state.velocity[size_t(it - state.sticks.begin())];
+      if (at[old] != SIZE_MAX && !state.velocity.empty()) velocity[i] = state.velocity[at[old]];
     }
   }
   // t (and the momentum) back on the sticks, and the sticks back on their lattice.
