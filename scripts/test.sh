@@ -16,7 +16,7 @@ phase "Release suite done"
 [ "${VOXPRESS_NO_SANITIZE:-0}" = 1 ] && exit 0
 
 echo "== the unit and property tests under ASan + UBSan" >&2
-suites=(core_tests extract_tests io_tests eval_tests smooth_tests simplify_tests voxart_tests render_tests labels_tests)
+suites=(core_tests extract_tests io_tests eval_tests smooth_tests simplify_tests voxart_tests render_tests labels_tests chunk_tests)
 # clang when present (setup installs it): it compiles the sanitized library
 # in half gcc's time.
 compilers=(); command -v clang++ >/dev/null 2>&1 && compilers=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang)
@@ -86,14 +86,19 @@ SharedSurface.PhantomLabelsAreClosedAndShareTheirInterfaces:SharedSurface.OneLab
 SharedSurface.SameBytesForAnyThreadCountAndBadInputIsRefused:SharedPress.PressedPhantomKeepsEveryGuarantee:\
 SharedPress.ShiftedPaddedAndCroppedPhantomGivesTheSameSurface:SharedFit.NestedSphereGetsItsBinaryFit:\
 SharedSimplify.PhantomKeepsEveryGuarantee"
+# The chunked run's rounds under the sanitizers on one small case (the
+# others, 7-10 s each in Release, ran above).
+export CHUNK_FILTER="Chunked.SameBytesForAnyThreadCountAndPieceOrder:Chunked.AHaloNarrowerThanOneSweepIsRefused:\
+Chunked.OneBlockIsTheWholeRunBitForBit:Chunked.GridCoversTheVolumeOnce"
 # smooth_tests, the longest, runs as four shards; the longest runs start
 # first (eval, io and extract next), so the two slots end together.
 runs=(smooth_tests:0:4 smooth_tests:1:4 smooth_tests:2:4 smooth_tests:3:4 eval_tests:0:1 labels_tests:0:1 io_tests:0:1
-      extract_tests:0:1 simplify_tests:0:1 voxart_tests:0:1 core_tests:0:1 render_tests:0:1)
+      extract_tests:0:1 simplify_tests:0:1 voxart_tests:0:1 core_tests:0:1 render_tests:0:1 chunk_tests:0:1)
 printf '%s\n' "${runs[@]}" | xargs -P "$(nproc)" -I{} sh -c '
   run=$1; t=${run%%:*}; rest=${run#*:}; i=${rest%%:*}; n=${rest#*:}
   log="$0/build-asan/$t.$i.log"
   [ "$t" = labels_tests ] && export GTEST_FILTER="$LABELS_FILTER"
+  [ "$t" = chunk_tests ] && export GTEST_FILTER="$CHUNK_FILTER"
   GTEST_SHARD_INDEX=$i GTEST_TOTAL_SHARDS=$n "$0/build-asan/tests/$t" --gtest_brief=1 > "$log" 2>&1 &&
     echo "sanitized $t ($((i + 1))/$n): passed" ||
     { echo "sanitized $t ($((i + 1))/$n): FAILED"; tail -40 "$log"; exit 1; }' "$root" {}
