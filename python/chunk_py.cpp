@@ -139,11 +139,12 @@ SurfacePiece on_cores(int threads, F&& f) {
   return piece;
 }
 
-PressState state_of(const py::list& pieces) {
+// The state block b reads from its neighbours' pieces.
+PressState state_of(const py::list& pieces, const ChunkGrid& grid, size_t b) {
   std::vector<SurfacePiece> ps;
   for (const py::handle& h : pieces) ps.push_back(from_dict(h.cast<py::dict>()));
   py::gil_scoped_release release;
-  return press_state(ps);
+  return press_state(ps, &grid, b);
 }
 
 py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
@@ -158,7 +159,7 @@ py::dict py_press_round(const py::array& mask, const py::handle& shape, size_t b
                         const py::object& direction, int threads, int first, int last, const py::list& state,
                         const py::kwargs& kw) {
   const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
-  const PressState st = state_of(state);
+  const PressState st = state_of(state, task.grid, block);
   return to_dict(on_cores(threads, [&] {
     return press_block_round(task.samples, task.grid, block, task.so, PressRound{first, last}, st);
   }));
@@ -169,7 +170,7 @@ py::dict py_finish_block(const py::array& mask, const py::handle& shape, size_t 
                          const py::object& direction, int threads, const py::list& state, bool measure,
                          const py::kwargs& kw) {
   const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
-  const PressState st = state_of(state);
+  const PressState st = state_of(state, task.grid, block);
   return to_dict(on_cores(threads, [&] { return finish_block(task.samples, task.grid, block, task.so, st, measure); }));
 }
 

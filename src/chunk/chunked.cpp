@@ -23,7 +23,7 @@ using detail::seconds_since;
 namespace {
 
 constexpr int64_t kMinChunk = 8;     // smaller blocks are all halo
-constexpr int64_t kMaxHalo = 256;    // beyond Pressing's reach at any level
+constexpr int64_t kMaxHalo = 256;    // samples: the widest halo accepted (27 rounds at 32 already: BENCHMARKS, Chunked)
 
 bool in_core(const Box& core, const std::array<int64_t, 3>& dims, const std::array<int64_t, 3>& g) {
   for (int a = 0; a < 3; ++a) {

@@ -111,14 +111,26 @@ std::vector<PressRound> press_rounds(const Lattice& lattice, const SurfaceOption
   return rounds;
 }
 
-PressState press_state(const std::vector<SurfacePiece>& pieces) {
+PressState press_state(const std::vector<SurfacePiece>& pieces, const ChunkGrid* grid, size_t b) {
   struct Ref {
     uint64_t key;
     uint32_t piece, index;
   };
+  // A key's lower sample (stick_key: padded x fastest, then the axis, y, z).
+  const Box read = grid ? grid->with_halo(b) : Box{};
+  const uint64_t px = grid ? uint64_t(grid->dims[0] + 2) : 1, py = grid ? uint64_t(grid->dims[1] + 2) : 1;
+  const auto wanted = [&](uint64_t key) {
+    if (!grid) return true;
+    const uint64_t row = key / px / 3;
+    const int64_t l[3] = {int64_t(key % px) - 1, int64_t(row % py) - 1, int64_t(row / py) - 1};
+    for (int a = 0; a < 3; ++a)
+      if (l[a] < read.lo[size_t(a)] - 1 || l[a] >= read.hi[size_t(a)]) return false;
+    return true;
+  };
   std::vector<Ref> refs;
   for (size_t p = 0; p < pieces.size(); ++p)
-    for (size_t i = 0; i < pieces[p].sticks.size(); ++i) refs.push_back({pieces[p].sticks[i], uint32_t(p), uint32_t(i)});
+    for (size_t i = 0; i < pieces[p].sticks.size(); ++i)
+      if (wanted(pieces[p].sticks[i])) refs.push_back({pieces[p].sticks[i], uint32_t(p), uint32_t(i)});
   tbb::parallel_sort(refs.begin(), refs.end(), [](const Ref& a, const Ref& b) { return a.key < b.key; });
   PressState out;
   out.sticks.resize(refs.size());

@@ -122,8 +122,10 @@ struct PressState {
   std::vector<uint64_t> sticks;
   std::vector<double> t, velocity;
 };
-/// The rounds' pieces (each block once, any order) as one state.
-PressState press_state(const std::vector<SurfacePiece>& pieces);
+/// The rounds' pieces (each block once, any order) as one state; with a
+/// grid, only the sticks block b reads (its box with the halo: what a Dask
+/// task needs of its neighbours' pieces).
+PressState press_state(const std::vector<SurfacePiece>& pieces, const ChunkGrid* grid = nullptr, size_t b = 0);
 
 /// Block b's round: its sticks (owned or in its halo) start from `state`
 /// (empty: the extraction's t, at rest), the round's sweeps run, and the
