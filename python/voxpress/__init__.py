@@ -51,8 +51,9 @@ def press(mask, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=No
                      ["curved-creases"] (the list: voxpress press --help)
       lambda_, mu  Taubin / Laplacian steps
       chunk, halo  block by block, as `press --chunk N [--halo H]`: without a
-                   halo the same mesh; with one, blocks pressed apart (no
-                   flats); voxpress.dask runs the blocks on Dask
+                   halo the same mesh; with one, blocks pressed apart in
+                   exchange rounds (no flats; the same surface as flats=False
+                   up to rounding); voxpress.dask runs the blocks on Dask
       faces, max_error  simplify the result (as `press --faces / --max-error`):
                    at most `faces` triangles, every input vertex within
                    max_error (physical units), every sample still on its side;
