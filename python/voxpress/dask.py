@@ -159,10 +159,10 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
         # whole run's surface. Where the whole run would stop (the first
         # sweep of its last stage whose residual is within the tolerance),
         # the graph is built again up to that sweep.
-        rounds = [tuple(r) for r in _voxpress._press_rounds(shape, halo=halo, bounds=(lo, hi), spacing=spacing,
+        # One block has no artificial border (its box is the volume's): one round, as in-process.
+        reach = halo if len(plan) > 1 else 2 ** 31 - 1
+        rounds = [tuple(r) for r in _voxpress._press_rounds(shape, halo=reach, bounds=(lo, hi), spacing=spacing,
                                                             origin=origin, direction=direction, **options)]
-        if len(plan) == 1:
-            rounds = [(rounds[0][0], rounds[-1][1])] if rounds else []
         tolerance = options.get("tolerance", 1e-4)
         tasks, residuals = _halo_tasks(plan, inside, rounds, True, common, options)
         out = compute(*tasks, *residuals)
