@@ -364,6 +364,8 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
   ProgressCounter progress(progress_sink, "rounds", uint64_t((rounds.size() + 1) * nb));
   PressStats st;
   st.levels = so.press.levels;
+  PressOptions po = so.press;  // the tolerance as the blocks run it (the overrides applied)
+  so.overrides.apply(po);
   const auto run_round = [&](const PressRound& r, const PressState& state) {
     detail::parallel_ranges(nb, 1, [&](detail::IndexRange range) {
       for (size_t b = range.begin(); b < range.end(); ++b) {
@@ -389,7 +391,7 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
       st.residual = res;
       st.least_residual = any ? std::min(st.least_residual, res) : res;
       any = true;
-      if (res <= so.press.tolerance) stop = r.first + k;
+      if (res <= po.tolerance) stop = r.first + k;
     }
     if (stop >= 0) {  // the whole run stops before sweep `stop`: this round again, up to it
       if (stop > r.first) run_round({r.first, stop}, state), ++round_count;
