@@ -2,6 +2,8 @@
 // block. Theory of operation: include/voxpress/chunk/chunked.h.
 #include <tbb/parallel_sort.h>
 
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -26,13 +28,17 @@ PressOptions block_press_options(const SurfaceOptions& o) {
   return po;
 }
 
-// Samples (index cells of the coarsest axis) that one sweep at `scale`
-// reaches: a vertex moves from the positions within twice the arc length
-// d * scale along its curves, plus the two curve segments its virtual
-// neighbours are interpolated on (each within a lattice square: at most
-// its diagonal), measured in the smallest spacing; one more for rounding.
+// Samples that one sweep at `scale` reaches: a vertex moves from the
+// positions within twice the arc length d * scale along its curves (d is
+// at most the longest physical cell side), plus the two curve segments its
+// virtual neighbours are interpolated on (each within a lattice square: at
+// most its diagonal); physical lengths become samples through the shortest
+// a unit index step can be (the index-to-physical map's smallest singular
+// value: the smallest spacing unless the lattice is sheared); one more for
+// rounding.
 int64_t sweep_reach(const Lattice& lattice, const PressOptions& po, int scale) {
-  const double smax = lattice.spacing.maxCoeff(), smin = lattice.spacing.minCoeff();
+  const Eigen::JacobiSVD<Mat3> svd(lattice.index_to_physical_matrix());
+  const double smax = svd.singularValues().maxCoeff(), smin = svd.singularValues().minCoeff();
   const double reach = (2 * scale * po.arc_length * smax + 2 * std::numbers::sqrt2 * smax) / smin;
   return int64_t(std::ceil(reach)) + 1;
 }
