@@ -94,6 +94,17 @@ py::list py_chunk_plan(const py::handle& shape, int64_t chunk, int64_t halo) {
   return out;
 }
 
+// press()'s keyword options as the chunked run uses them
+// (chunk_surface_options: levels from the inside box `bounds`).
+SurfaceOptions chunk_options(const py::kwargs& kw, const py::tuple& bounds) {
+  SurfaceOptions o;
+  set_options(o, kw);
+  if (bounds.size() != 2) throw UsageError("bounds must be (lo, hi): the box of the inside samples");
+  VolumeSummary summary;
+  summary.bounds = {corner(bounds[0], "bounds lo"), corner(bounds[1], "bounds hi")};
+  return chunk_surface_options(o, summary);
+}
+
 // One block of a plan, as the Dask task reads it: the whole lattice, the
 // grid, the block's samples (its read box, non-zero inside) and the options
 // chunk_surface_options gives (levels from the inside box `bounds`).
@@ -105,14 +116,10 @@ struct BlockTask {
   BlockTask(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
             const py::tuple& bounds, const py::object& spacing, const py::object& origin, const py::object& direction,
             const py::kwargs& kw)
-      : lattice(whole_lattice(shape, spacing, origin, direction)), grid(lattice.dims, ChunkOptions{chunk, halo}) {
-    SurfaceOptions o;
-    set_options(o, kw);
+      : lattice(whole_lattice(shape, spacing, origin, direction)),
+        grid(lattice.dims, ChunkOptions{chunk, halo}),
+        so(chunk_options(kw, bounds)) {
     if (block >= grid.count()) throw UsageError("block " + std::to_string(block) + " is not in the plan");
-    if (bounds.size() != 2) throw UsageError("bounds must be (lo, hi): the box of the inside samples");
-    VolumeSummary summary;
-    summary.bounds = {corner(bounds[0], "bounds lo"), corner(bounds[1], "bounds hi")};
-    so = chunk_surface_options(o, summary);
     const Box box = grid.with_halo(block);
     ScalarVolume scalar = to_volume(mask, py::make_tuple(1, 1, 1), py::make_tuple(0, 0, 0), py::none(), "xyz");
     if (scalar.lattice.dims != box.dims())
@@ -177,13 +184,8 @@ py::dict py_finish_block(const py::array& mask, const py::handle& shape, size_t 
 py::list py_press_rounds(const py::handle& shape, int64_t halo, const py::tuple& bounds, const py::object& spacing,
                          const py::object& origin, const py::object& direction, const py::kwargs& kw) {
   const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
-  SurfaceOptions o;
-  set_options(o, kw);
-  if (bounds.size() != 2) throw UsageError("bounds must be (lo, hi): the box of the inside samples");
-  VolumeSummary summary;
-  summary.bounds = {corner(bounds[0], "bounds lo"), corner(bounds[1], "bounds hi")};
   py::list out;
-  for (const PressRound& r : press_rounds(lattice, chunk_surface_options(o, summary), halo))
+  for (const PressRound& r : press_rounds(lattice, chunk_options(kw, bounds), halo))
     out.append(py::make_tuple(r.first, r.last));
   return out;
 }
@@ -403,6 +405,7 @@ PyMesh press_chunked_volume(const ScalarVolume& scalar, const Selection& sel, co
   out.stats["vertices"] = out.mesh.vertex_count();
   out.stats["triangles"] = out.mesh.face_count();
   out.stats["iterations"] = r.press.iterations;
+  if (o.method == Method::pressing) out.stats["residual"] = r.press.residual;  // as press()'s, the halo mode's too
   out.stats["flats"] = r.flats.flats.size();
   out.stats["sharp_edges"] = out.mesh.edges.size();
   out.stats["keeps_classification"] = keeps_classification(o.method);

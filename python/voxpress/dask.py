@@ -58,6 +58,11 @@ def _finish(mask, state, **kw):
     return _voxpress._finish_block(np.asarray(mask), state=list(state), **kw)
 
 
+def _final_residual(*pieces):
+    """The whole run's residual at its final t: the max over the blocks' last steps."""
+    return max((float(p["residuals"][0]) for p in pieces if len(p["residuals"])), default=0.0)
+
+
 def _sweep_residuals(*pieces):
     """The whole run's residual per sweep of a round: the max over its blocks (NaN before the last stage)."""
     rows = [p["residuals"] for p in pieces if len(p["residuals"])]
@@ -85,15 +90,29 @@ def _halo_tasks(plan, inside, rounds, measure, common, options):
     step, finish, sweeps = dask.delayed(_round, pure=True), dask.delayed(_finish, pure=True), \
         dask.delayed(_sweep_residuals, pure=True)
     last, residuals = None, []
+
+    def state(i):  # the pieces around block i from the round before (none before the first)
+        return [] if last is None else [last[c] for c in around[i]]
+
     for first, end in rounds:
-        state = [[] if last is None else [last[c] for c in around[b["block"]]] for b in plan]
-        last = [step(masks[i], state[i], block=b["block"], first=first, last=end, **common, **options)
+        last = [step(masks[i], state(i), block=b["block"], first=first, last=end, **common, **options)
                 for i, b in enumerate(plan)]
         residuals.append(sweeps(*last))
-    state = [[] if last is None else [last[c] for c in around[b["block"]]] for b in plan]
-    done = [finish(masks[i], state[i], block=b["block"], measure=measure, **common, **options)
+    done = [finish(masks[i], state(i), block=b["block"], measure=measure, **common, **options)
             for i, b in enumerate(plan)]
     return done, residuals
+
+
+def _merged(tasks, split_every, shape):
+    """Tree reduction: up to split_every consecutive pieces merge on a worker
+    (a k-way merge in whole-run order), level after level, until the caller
+    has at most split_every of them to stitch."""
+    import dask
+
+    merge = dask.delayed(_merge, pure=True)
+    while len(tasks) > split_every:
+        tasks = [merge(*tasks[i:i + split_every], shape=shape) for i in range(0, len(tasks), split_every)]
+    return tasks
 
 
 def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0), direction=None,
@@ -164,32 +183,25 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
         rounds = [tuple(r) for r in _voxpress._press_rounds(shape, halo=reach, bounds=(lo, hi), spacing=spacing,
                                                             origin=origin, direction=direction, **options)]
         tolerance = options.get("tolerance", 1e-4)
-        tasks, residuals = _halo_tasks(plan, inside, rounds, True, common, options)
-        out = compute(*tasks, *residuals)
-        tasks, residuals = out[:len(tasks)], out[len(tasks):]
+        done, residuals = _halo_tasks(plan, inside, rounds, True, common, options)
+        tasks = _merged(done, split_every, shape)
+        out = compute(*tasks, dask.delayed(_final_residual, pure=True)(*done), *residuals)
+        pieces, final, residuals = out[:len(tasks)], out[len(tasks)], out[len(tasks) + 1:]
         sweep = [(r[0] + k, v) for r, row in zip(rounds, residuals) for k, v in enumerate(row) if not np.isnan(v)]
         stop = next(((k, v) for k, v in sweep if v <= tolerance), None)
         if stop is not None:
             cut = [(a, min(b, stop[0])) for a, b in rounds if a < stop[0]]
-            tasks = compute(*_halo_tasks(plan, inside, cut, False, common, options)[0])
+            pieces = compute(*_merged(_halo_tasks(plan, inside, cut, False, common, options)[0], split_every, shape))
             pressed = {"iterations": stop[0], "residual": stop[1]}
         else:
-            final = max((p["residuals"][0] for p in tasks if len(p["residuals"])), default=0.0)
-            pressed = {"iterations": rounds[-1][1] if rounds else 0, "residual": float(final)}
-        tasks = [dask.delayed(p) for p in tasks]
+            pressed = {"iterations": rounds[-1][1] if rounds else 0, "residual": final}
     else:
         block = dask.delayed(_block, pure=True)
         tasks = []
         for b in plan:
             (x0, y0, z0), (x1, y1, z1) = b["read"]
             tasks.append(block(inside[x0:x1, y0:y1, z0:z1], block=b["block"], **common))
-    # Tree reduction: up to split_every consecutive pieces merge on a worker
-    # (a k-way merge in whole-run order), level after level, until the
-    # caller has at most split_every of them to stitch.
-    merge = dask.delayed(_merge, pure=True)
-    while len(tasks) > split_every:
-        tasks = [merge(*tasks[i:i + split_every], shape=shape) for i in range(0, len(tasks), split_every)]
-    pieces = list(compute(*tasks))
+        pieces = compute(*_merged(tasks, split_every, shape))
     mesh = _voxpress._stitch(pieces, shape=shape, spacing=spacing, origin=origin, direction=direction,
                              smooth=not halo, **(options if not halo else {}))
     for key, value in pressed.items():

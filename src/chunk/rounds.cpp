@@ -2,7 +2,7 @@
 // block. Theory of operation: include/voxpress/chunk/chunked.h.
 #include <tbb/parallel_sort.h>
 
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -37,8 +37,9 @@ PressOptions block_press_options(const SurfaceOptions& o) {
 // value: the smallest spacing unless the lattice is sheared); one more for
 // rounding.
 int64_t sweep_reach(const Lattice& lattice, const PressOptions& po, int scale) {
-  const Eigen::JacobiSVD<Mat3> svd(lattice.index_to_physical_matrix());
-  const double smax = svd.singularValues().maxCoeff(), smin = svd.singularValues().minCoeff();
+  const Mat3 M = lattice.index_to_physical_matrix();
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(M.transpose() * M, Eigen::EigenvaluesOnly);  // singular values squared
+  const double smax = std::sqrt(es.eigenvalues().maxCoeff()), smin = std::sqrt(es.eigenvalues().minCoeff());
   const double reach = (2 * scale * po.arc_length * smax + 2 * std::numbers::sqrt2 * smax) / smin;
   return int64_t(std::ceil(reach)) + 1;
 }
@@ -82,9 +83,12 @@ struct BlockPress {
       if (at[old] != SIZE_MAX && !state.velocity.empty()) velocity[i] = state.velocity[at[old]];
     }
   }
-  // t (and the momentum) back on the sticks, and the sticks back on their lattice.
-  void put_back() {
+  // t back on the sticks, `also` run on them while they are on their own
+  // box, and the sticks back on their lattice.
+  template <class Also = void (*)(StickSurface&)>
+  void put_back(Also also = [](StickSurface&) {}) {
     for (size_t i = 0; i < t.size(); ++i) bs.s.t[layout.old_of[i]] = t[i];
+    also(bs.s);
     bs.s = off_own_box(std::move(bs.s), frame);
   }
 };
@@ -137,7 +141,7 @@ PressState press_state(const std::vector<SurfacePiece>& pieces, const ChunkGrid*
   for (size_t p = 0; p < pieces.size(); ++p)
     for (size_t i = 0; i < pieces[p].sticks.size(); ++i)
       if (wanted(pieces[p].sticks[i])) refs.push_back({pieces[p].sticks[i], uint32_t(p), uint32_t(i)});
-  tbb::parallel_sort(refs.begin(), refs.end(), [](const Ref& a, const Ref& b) { return a.key < b.key; });
+  tbb::parallel_sort(refs.begin(), refs.end(), [](const Ref& x, const Ref& y) { return x.key < y.key; });
   PressState out;
   out.sticks.resize(refs.size());
   out.t.resize(refs.size());
@@ -181,17 +185,13 @@ SurfacePiece finish_block(const BinaryVolume& samples, const ChunkGrid& grid, si
   const PressOptions po = block_press_options(options);
   double residual = 0;
   if (measure && !bp.t.empty()) residual = detail::residual_at(bp.t, bp.layout.families, 2, po, &bp.owned);
-  bp.put_back();
-  StickSurface& s = bp.bs.s;
-  if (options.passes.on(Pass::quadric_fit) && s.stick_count() > 0) {
+  bp.put_back([&](StickSurface& s) {
+    if (!options.passes.on(Pass::quadric_fit) || s.stick_count() == 0) return;
     // The whole run's fit without flats (smooth/pipeline.cpp): no region, no junction.
     QuadricFitOptions fo = options.fit;
     fo.margin = po.margin;
-    OwnBox frame;
-    s = on_own_box(std::move(s), &frame);
     fit_local_quadrics(s, std::vector<int32_t>(s.stick_count(), -1), {}, fo);
-    s = off_own_box(std::move(s), frame);
-  }
+  });
   SurfacePiece out = detail::owned_piece(bp.bs, grid, b, true);
   if (measure) out.residuals.assign(1, residual);
   return out;

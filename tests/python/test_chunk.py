@@ -96,6 +96,7 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
     np.testing.assert_array_equal(again.vertices, small.vertices)
     np.testing.assert_array_equal(again.faces, small.faces)
     assert again.stats["iterations"] == small.stats["iterations"]
+    assert again.stats["residual"] == small.stats["residual"]
     with pytest.raises(voxpress.InputError):
         voxpress.dask.press(da.zeros((32, 32, 32), chunks=16), chunk=16)
     with pytest.raises(voxpress.UsageError):
