@@ -9,6 +9,8 @@
 
 #include <cstring>
 #include <optional>
+#include <set>
+#include <span>
 
 #include "py_common.h"
 
@@ -134,24 +136,33 @@ struct BlockTask {
 
 // f() on `threads` cores (a Dask worker's share of the machine; 0: all), without the GIL.
 template <class F>
-SurfacePiece on_cores(int threads, F&& f) {
-  SurfacePiece piece;
+auto on_cores(int threads, F&& f) {
   py::gil_scoped_release release;
-  if (threads > 0) {
-    tbb::task_arena arena(threads);
-    arena.execute([&] { piece = f(); });
-  } else {
-    piece = f();
-  }
-  return piece;
+  if (threads <= 0) return f();
+  tbb::task_arena arena(threads);
+  return arena.execute([&] { return f(); });
 }
 
-// The state block b reads from its neighbours' pieces.
-PressState state_of(const py::list& pieces, const ChunkGrid& grid, size_t b) {
-  std::vector<SurfacePiece> ps;
-  for (const py::handle& h : pieces) ps.push_back(from_dict(h.cast<py::dict>()));
-  py::gil_scoped_release release;
-  return press_state(ps, &grid, b);
+// The state a block reads: views of its neighbours' pieces (numpy arrays,
+// kept alive in `held` while the round runs).
+template <class T>
+std::span<const T> view(const py::dict& piece, const char* key, std::vector<py::object>& held) {
+  if (!piece.contains(key)) throw UsageError(std::string("a piece lacks '") + key + "' (not from a round?)");
+  const auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(piece[key]);
+  if (!a) throw UsageError(std::string("a piece's '") + key + "' is not an array");
+  held.push_back(a);
+  return {a.data(), size_t(a.size())};
+}
+
+PressState state_of(const py::list& pieces, std::vector<py::object>& held) {
+  PressState st;
+  for (const py::handle& h : pieces) {
+    const py::dict d = h.cast<py::dict>();
+    if (!d.contains("block")) throw UsageError("a piece lacks 'block' (not from a round?)");
+    st.pieces.push_back({d["block"].cast<uint64_t>(), view<uint64_t>(d, "sticks", held), view<double>(d, "t", held),
+                         d.contains("velocity") ? view<double>(d, "velocity", held) : std::span<const double>{}});
+  }
+  return st;
 }
 
 py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
@@ -161,32 +172,57 @@ py::dict py_press_block(const py::array& mask, const py::handle& shape, size_t b
   return to_dict(on_cores(threads, [&] { return press_block(task.samples, task.grid, block); }));
 }
 
-py::dict py_press_round(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
-                        const py::tuple& bounds, const py::object& spacing, const py::object& origin,
-                        const py::object& direction, int threads, int first, int last, const py::list& state,
-                        const py::kwargs& kw) {
-  const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
-  const PressState st = state_of(state, task.grid, block);
-  return to_dict(on_cores(threads, [&] {
-    return press_block_round(task.samples, task.grid, block, task.so, PressRound{first, last}, st);
-  }));
-}
+// A block of the halo mode between its rounds (voxpress.dask): extracted
+// once from its read box; it pickles as what built it (the mask and the
+// arguments), so a worker that receives it extracts it again.
+class PyBlockRounds {
+ public:
+  PyBlockRounds(py::array mask, py::dict args) : mask_(std::move(mask)), args_(std::move(args)) {
+    const auto get = [&](const char* key, py::object fallback) {
+      return args_.contains(key) ? py::reinterpret_borrow<py::object>(args_[key]) : fallback;
+    };
+    py::kwargs kw;
+    for (const auto& [key, value] : args_)
+      if (!kNamed.count(key.cast<std::string>())) kw[key] = value;
+    for (const char* key : {"shape", "block", "chunk", "halo", "bounds"})
+      if (!args_.contains(key)) throw UsageError(std::string("_BlockRounds needs ") + key);
+    block_ = args_["block"].cast<size_t>();
+    threads_ = get("threads", py::int_(0)).cast<int>();
+    const BlockTask task(mask_, args_["shape"], block_, args_["chunk"].cast<int64_t>(), args_["halo"].cast<int64_t>(),
+                         args_["bounds"].cast<py::tuple>(), get("spacing", py::make_tuple(1.0, 1.0, 1.0)),
+                         get("origin", py::make_tuple(0.0, 0.0, 0.0)), get("direction", py::none()), kw);
+    rounds_ = std::make_shared<BlockRounds>(
+        on_cores(threads_, [&] { return BlockRounds(task.samples, task.grid, block_, task.so); }));
+  }
+  py::dict round(const py::list& state, int first, int last) const {
+    std::vector<py::object> held;
+    const PressState st = state_of(state, held);
+    return to_dict(on_cores(threads_, [&] { return rounds_->round(PressRound{first, last}, st); }));
+  }
+  py::dict finish(const py::list& state, bool measure) const {
+    std::vector<py::object> held;
+    const PressState st = state_of(state, held);
+    return to_dict(on_cores(threads_, [&] { return rounds_->finish(st, measure); }));
+  }
+  uint64_t nbytes() const { return rounds_->bytes() + uint64_t(mask_.nbytes()); }
+  py::tuple state() const { return py::make_tuple(mask_, args_); }
 
-py::dict py_finish_block(const py::array& mask, const py::handle& shape, size_t block, int64_t chunk, int64_t halo,
-                         const py::tuple& bounds, const py::object& spacing, const py::object& origin,
-                         const py::object& direction, int threads, const py::list& state, bool measure,
-                         const py::kwargs& kw) {
-  const BlockTask task(mask, shape, block, chunk, halo, bounds, spacing, origin, direction, kw);
-  const PressState st = state_of(state, task.grid, block);
-  return to_dict(on_cores(threads, [&] { return finish_block(task.samples, task.grid, block, task.so, st, measure); }));
-}
+ private:
+  static inline const std::set<std::string> kNamed = {"shape",  "block",   "chunk",     "halo",   "bounds",
+                                                       "spacing", "origin", "direction", "threads"};
+  py::array mask_;
+  py::dict args_;
+  size_t block_ = 0;
+  int threads_ = 0;
+  std::shared_ptr<const BlockRounds> rounds_;
+};
 
 py::list py_press_rounds(const py::handle& shape, int64_t halo, const py::tuple& bounds, const py::object& spacing,
                          const py::object& origin, const py::object& direction, const py::kwargs& kw) {
   const Lattice lattice = whole_lattice(shape, spacing, origin, direction);
   py::list out;
   for (const PressRound& r : press_rounds(lattice, chunk_options(kw, bounds), halo))
-    out.append(py::make_tuple(r.first, r.last));
+    out.append(py::make_tuple(r.first, r.last, r.measured));
   return out;
 }
 
@@ -425,17 +461,23 @@ void bind_chunks(py::module_& m) {
   m.def("_press_rounds", &py_press_rounds, py::arg("shape"), py::kw_only(), py::arg("halo"), py::arg("bounds"),
         py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0), py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0),
         py::arg("direction") = py::none(),
-        "The halo mode's rounds [(first, last)]: sweeps of the whole run between exchanges (press_rounds).");
-  m.def("_press_round", &py_press_round, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
-        py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
-        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
-        py::arg("first"), py::arg("last"), py::arg("state"),
-        "One block's round: sweeps [first, last) from the state of the pieces of the last round around it.");
-  m.def("_finish_block", &py_finish_block, py::arg("mask"), py::kw_only(), py::arg("shape"), py::arg("block"),
-        py::arg("chunk"), py::arg("halo"), py::arg("bounds"), py::arg("spacing") = py::make_tuple(1.0, 1.0, 1.0),
-        py::arg("origin") = py::make_tuple(0.0, 0.0, 0.0), py::arg("direction") = py::none(), py::arg("threads") = 0,
-        py::arg("state"), py::arg("measure") = true,
-        "One block's last step after the rounds: the residual at the final t, the quadric fit, its piece.");
+        "The halo mode's rounds [(first, last, measured)]: sweeps of the whole run between exchanges "
+        "(press_rounds); measured: the round holds sweeps of the last stage.");
+  py::class_<PyBlockRounds>(m, "_BlockRounds",
+                            "One block of the halo mode, extracted once from its read box (mask) and pressed round "
+                            "after round (voxpress.dask); args: shape, block, chunk, halo, bounds, spacing, origin, "
+                            "direction, threads and press()'s options. Pickles as (mask, args).")
+      .def(py::init<py::array, py::dict>(), py::arg("mask"), py::arg("args"))
+      .def("round", &PyBlockRounds::round, py::arg("state"), py::arg("first"), py::arg("last"),
+           "Sweeps [first, last) from the state of the pieces of the last round around the block: its piece.")
+      .def("finish", &PyBlockRounds::finish, py::arg("state"), py::arg("measure") = true,
+           "The last step after the rounds: the residual at the final t, the quadric fit, the block's piece.")
+      .def_property_readonly("nbytes", &PyBlockRounds::nbytes, "Memory held (what Dask's sizeof reports).")
+      .def(py::pickle([](const PyBlockRounds& b) { return b.state(); },
+                      [](const py::tuple& s) {
+                        if (s.size() != 2) throw UsageError("_BlockRounds: a bad pickle");
+                        return PyBlockRounds(s[0].cast<py::array>(), s[1].cast<py::dict>());
+                      }));
   m.def("_merge", &py_merge, py::arg("pieces"), py::kw_only(), py::arg("shape"),
         "One piece of consecutive ones (each one's blocks follow the one before): a step of voxpress.dask's tree "
         "reduction.");

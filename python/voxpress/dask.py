@@ -9,8 +9,9 @@
 
 The volume is cut into blocks of `chunk` samples per side (voxpress.chunk_plan).
 Each block, read with `halo` more samples on every side, is one Dask task
-(voxpress._press_block, run on a worker; with a halo, one per round of
-sweeps, voxpress._press_round, then voxpress._finish_block) returning its
+(voxpress._press_block, run on a worker; with a halo, the block is
+extracted once, voxpress._BlockRounds, and pressed in one task per round
+of sweeps, then finished) returning its
 piece of the surface:
 numpy arrays of global stick keys, codes, pressed positions and triangles,
 which pickle compactly. Consecutive pieces merge on the workers, up to
@@ -25,6 +26,7 @@ and retries; nothing here is a scheduler.
 import warnings
 
 import numpy as np
+from dask.sizeof import sizeof
 
 from . import _voxpress
 
@@ -50,12 +52,22 @@ def _merge(*pieces, **kw):  # a module function pickles by name; the binding its
     return _voxpress._merge(list(pieces), **kw)
 
 
-def _round(mask, state, **kw):
-    return _voxpress._press_round(np.asarray(mask), state=list(state), **kw)
+def _hold(mask, args):
+    """Block i of the halo mode, extracted once: kept on its worker between its rounds."""
+    return _voxpress._BlockRounds(np.asarray(mask), args)
 
 
-def _finish(mask, state, **kw):
-    return _voxpress._finish_block(np.asarray(mask), state=list(state), **kw)
+def _round(held, state, first, last):
+    return held.round(list(state), first, last)
+
+
+def _finish(held, state, measure):
+    return held.finish(list(state), measure)
+
+
+@sizeof.register(_voxpress._BlockRounds)
+def _sizeof_block(held):  # its true size, so that Dask runs a block's rounds where it is held
+    return int(held.nbytes)
 
 
 def _final_residual(*pieces):
@@ -74,33 +86,45 @@ def _sweep_residuals(*pieces):
 
 
 def _halo_tasks(plan, inside, rounds, measure, common, options):
-    """The halo mode's graph: one task per block per round, each reading the
-    pieces of the blocks whose core meets its read box from the round
-    before, then each block's last step; and per round, the residual per sweep."""
+    """The halo mode's graph: each block extracted once (_hold), one task per
+    block per round reading the pieces of the blocks whose core meets its
+    read box from the round before, then each block's last step; and per
+    round that holds sweeps of the last stage, the residual per sweep. The
+    rounds' tasks are one graph layer (thousands of tasks: built as a dict,
+    not one Delayed call each)."""
     import dask
+    from dask.base import tokenize
+    from dask.delayed import Delayed
+    from dask.highlevelgraph import HighLevelGraph
 
     def meets(core, read):
         return all(core[0][a] < read[1][a] and read[0][a] < core[1][a] for a in range(3))
 
     around = [[c["block"] for c in plan if meets(c["core"], b["read"])] for b in plan]
-    masks = []
+    hold = dask.delayed(_hold, pure=True)
+    held = []
     for b in plan:
         (x0, y0, z0), (x1, y1, z1) = b["read"]
-        masks.append(inside[x0:x1, y0:y1, z0:z1])
-    step, finish, sweeps = dask.delayed(_round, pure=True), dask.delayed(_finish, pure=True), \
-        dask.delayed(_sweep_residuals, pure=True)
-    last, residuals = None, []
+        held.append(hold(inside[x0:x1, y0:y1, z0:z1], dict(block=b["block"], **common, **options)))
+    name = "voxpress-rounds-" + tokenize([h.key for h in held], rounds, measure)
+    layer, last, residuals = {}, None, []
 
     def state(i):  # the pieces around block i from the round before (none before the first)
         return [] if last is None else [last[c] for c in around[i]]
 
-    for first, end in rounds:
-        last = [step(masks[i], state(i), block=b["block"], first=first, last=end, **common, **options)
-                for i, b in enumerate(plan)]
-        residuals.append(sweeps(*last))
-    done = [finish(masks[i], state(i), block=b["block"], measure=measure, **common, **options)
-            for i, b in enumerate(plan)]
-    return done, residuals
+    for r, (first, end, measured) in enumerate(rounds):
+        keys = [f"{name}-{r}-{i}" for i in range(len(plan))]
+        for i, key in enumerate(keys):
+            layer[key] = (_round, held[i].key, state(i), first, end)
+        last = keys
+        if measured:
+            layer[f"{name}-residuals-{r}"] = (_sweep_residuals, *keys)
+            residuals.append((r, f"{name}-residuals-{r}"))
+    done = [f"{name}-finish-{i}" for i in range(len(plan))]
+    for i, key in enumerate(done):
+        layer[key] = (_finish, held[i].key, state(i), measure)
+    graph = HighLevelGraph.from_collections(name, layer, dependencies=held)
+    return [Delayed(k, graph, layer=name) for k in done], [(r, Delayed(k, graph, layer=name)) for r, k in residuals]
 
 
 def _merged(tasks, split_every, shape):
@@ -183,14 +207,15 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
         rounds = [tuple(r) for r in _voxpress._press_rounds(shape, halo=reach, bounds=(lo, hi), spacing=spacing,
                                                             origin=origin, direction=direction, **options)]
         tolerance = options.get("tolerance", 1e-4)
-        done, residuals = _halo_tasks(plan, inside, rounds, True, common, options)
+        done, measured = _halo_tasks(plan, inside, rounds, True, common, options)
         tasks = _merged(done, split_every, shape)
-        out = compute(*tasks, dask.delayed(_final_residual, pure=True)(*done), *residuals)
-        pieces, final, residuals = out[:len(tasks)], out[len(tasks)], out[len(tasks) + 1:]
-        sweep = [(r[0] + k, v) for r, row in zip(rounds, residuals) for k, v in enumerate(row) if not np.isnan(v)]
+        out = compute(*tasks, dask.delayed(_final_residual, pure=True)(*done), *[d for _, d in measured])
+        pieces, final, rows = out[:len(tasks)], out[len(tasks)], out[len(tasks) + 1:]
+        sweep = [(rounds[r][0] + k, v) for (r, _), row in zip(measured, rows) for k, v in enumerate(row)
+                 if not np.isnan(v)]
         stop = next(((k, v) for k, v in sweep if v <= tolerance), None)
         if stop is not None:
-            cut = [(a, min(b, stop[0])) for a, b in rounds if a < stop[0]]
+            cut = [(a, min(b, stop[0]), m) for a, b, m in rounds if a < stop[0]]
             pieces = compute(*_merged(_halo_tasks(plan, inside, cut, False, common, options)[0], split_every, shape))
             pressed = {"iterations": stop[0], "residual": stop[1]}
         else:

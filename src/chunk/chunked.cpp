@@ -5,6 +5,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <optional>
 #include <queue>
 #include <atomic>
 #include <chrono>
@@ -69,6 +70,12 @@ Box ChunkGrid::with_halo(size_t b) const {
     box.hi[size_t(a)] = std::min(dims[size_t(a)], box.hi[size_t(a)] + h);
   }
   return box;
+}
+
+size_t ChunkGrid::block_of(const std::array<int64_t, 3>& sample) const {
+  int64_t idx[3];
+  for (int a = 0; a < 3; ++a) idx[a] = std::clamp<int64_t>(sample[size_t(a)], 0, dims[size_t(a)] - 1) / chunk;
+  return size_t(idx[0] + n_[0] * (idx[1] + n_[1] * idx[2]));
 }
 
 void VolumeSummary::add(const BinaryVolume& v, const Box& where) {
@@ -361,19 +368,26 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
   // One block has no artificial border (its box is the volume's): one round.
   const std::vector<PressRound> rounds = press_rounds(lattice, so, grid.count() == 1 ? INT32_MAX : grid.halo);
   const size_t nb = grid.count();
-  ProgressCounter progress(progress_sink, "rounds", uint64_t((rounds.size() + 1) * nb));
+  ProgressCounter progress(progress_sink, "rounds", uint64_t((rounds.size() + 2) * nb));
   PressStats st;
   st.levels = so.press.levels;
   PressOptions po = so.press;  // the tolerance as the blocks run it (the overrides applied)
   so.overrides.apply(po);
-  const auto run_round = [&](const PressRound& r, const PressState& state) {
+  // Each block read and extracted once (as a Dask worker keeps it).
+  std::vector<std::optional<BlockRounds>> blocks(nb);
+  const auto each_block = [&](auto&& f) {
     detail::parallel_ranges(nb, 1, [&](detail::IndexRange range) {
       for (size_t b = range.begin(); b < range.end(); ++b) {
-        pieces[b] = press_block_round(block_of(b), grid, b, so, r, state);
+        f(b);
         progress.add(1);
       }
     });
   };
+  each_block([&](size_t b) { blocks[b].emplace(block_of(b), grid, b, so); });
+  const auto run_round = [&](const PressRound& r, const PressState& state) {
+    each_block([&](size_t b) { pieces[b] = blocks[b]->round(r, state); });
+  };
+  std::vector<SurfacePiece> last(nb);  // the pieces the state views (pieces: the round's, swapped)
   PressState state;
   bool stopped = false, any = false;
   round_count = 0;
@@ -400,15 +414,13 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
     } else {
       st.iterations = r.last;
     }
-    if (!stopped || st.iterations > r.first) state = press_state(pieces);  // stopped at the round's start: the state before it
+    if (!stopped || st.iterations > r.first) {  // stopped at the round's start: the state before it
+      std::swap(last, pieces);
+      state = press_state(last);
+    }
     if (stopped) break;
   }
-  detail::parallel_ranges(nb, 1, [&](detail::IndexRange range) {
-    for (size_t b = range.begin(); b < range.end(); ++b) {
-      pieces[b] = finish_block(block_of(b), grid, b, so, state, !stopped);
-      progress.add(1);
-    }
-  });
+  each_block([&](size_t b) { pieces[b] = blocks[b]->finish(state, !stopped); });
   if (!stopped) {  // the cap ended it: the residual at the final t
     double res = 0;
     for (const SurfacePiece& p : pieces)

@@ -44,55 +44,6 @@ int64_t sweep_reach(const Lattice& lattice, const PressOptions& po, int scale) {
   return int64_t(std::ceil(reach)) + 1;
 }
 
-// The block's sticks placed for pressing: on their own box (as the whole
-// run), in the layout's order, with t and momentum from `state` (sticks
-// it does not hold, the block's artificial border: the extraction's, at
-// rest).
-struct BlockPress {
-  detail::BlockSticks bs;
-  OwnBox frame;
-  SliceCurves curves;  // the layout's families point into it
-  detail::Layout layout;
-  std::vector<double> t, velocity;
-  std::vector<uint8_t> owned;  // layout order
-  BlockPress(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const PressState& state)
-      : bs(detail::block_sticks(samples, grid, b, ExtractOptions{})) {
-    const size_t n = bs.s.stick_count();
-    // Where each stick is in the state (SIZE_MAX: not there). A block's
-    // sticks are in whole-run key order (the canonical order of a sub-box),
-    // so one forward search finds them all.
-    std::vector<size_t> at(n, SIZE_MAX);
-    const bool sorted = std::is_sorted(bs.key.begin(), bs.key.end());
-    auto from = state.sticks.begin();
-    for (size_t i = 0; i < n; ++i) {
-      from = std::lower_bound(sorted ? from : state.sticks.begin(), state.sticks.end(), bs.key[i]);
-      if (from == state.sticks.end() || *from != bs.key[i]) continue;
-      at[i] = size_t(from - state.sticks.begin());
-      bs.s.t[i] = state.t[at[i]];
-    }
-    bs.s = on_own_box(std::move(bs.s), &frame);
-    curves = build_slice_curves(bs.s);
-    detail::make_layout(bs.s, curves, layout);
-    t.resize(n);
-    velocity.assign(n, 0.0);
-    owned.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t old = layout.old_of[i];
-      t[i] = bs.s.t[old];
-      owned[i] = bs.owned[old];
-      if (at[old] != SIZE_MAX && !state.velocity.empty()) velocity[i] = state.velocity[at[old]];
-    }
-  }
-  // t back on the sticks, `also` run on them while they are on their own
-  // box, and the sticks back on their lattice.
-  template <class Also = void (*)(StickSurface&)>
-  void put_back(Also also = [](StickSurface&) {}) {
-    for (size_t i = 0; i < t.size(); ++i) bs.s.t[layout.old_of[i]] = t[i];
-    also(bs.s);
-    bs.s = off_own_box(std::move(bs.s), frame);
-  }
-};
-
 }  // namespace
 
 std::vector<PressRound> press_rounds(const Lattice& lattice, const SurfaceOptions& options, int64_t halo) {
@@ -115,84 +66,153 @@ std::vector<PressRound> press_rounds(const Lattice& lattice, const SurfaceOption
       used += step;
       ++r.last;
     }
+    r.measured = std::min(levels - 1, (r.last - 1) * levels / cap) == levels - 1;  // iterate()'s stage of its last sweep
     rounds.push_back(r);
     k = r.last;
   }
   return rounds;
 }
 
-PressState press_state(const std::vector<SurfacePiece>& pieces, const ChunkGrid* grid, size_t b) {
-  struct Ref {
-    uint64_t key;
-    uint32_t piece, index;
-  };
-  // A key's lower sample (stick_key: padded x fastest, then the axis, y, z).
-  const Box read = grid ? grid->with_halo(b) : Box{};
-  const uint64_t px = grid ? uint64_t(grid->dims[0] + 2) : 1, py = grid ? uint64_t(grid->dims[1] + 2) : 1;
-  const auto wanted = [&](uint64_t key) {
-    if (!grid) return true;
-    const uint64_t row = key / px / 3;
-    const int64_t l[3] = {int64_t(key % px) - 1, int64_t(row % py) - 1, int64_t(row / py) - 1};
-    for (int a = 0; a < 3; ++a)
-      if (l[a] < read.lo[size_t(a)] - 1 || l[a] >= read.hi[size_t(a)]) return false;
-    return true;
-  };
-  std::vector<Ref> refs;
-  for (size_t p = 0; p < pieces.size(); ++p)
-    for (size_t i = 0; i < pieces[p].sticks.size(); ++i)
-      if (wanted(pieces[p].sticks[i])) refs.push_back({pieces[p].sticks[i], uint32_t(p), uint32_t(i)});
-  tbb::parallel_sort(refs.begin(), refs.end(), [](const Ref& x, const Ref& y) { return x.key < y.key; });
+PressState press_state(const std::vector<SurfacePiece>& pieces) {
   PressState out;
-  out.sticks.resize(refs.size());
-  out.t.resize(refs.size());
-  out.velocity.resize(refs.size());
-  detail::parallel_for(refs.size(), [&](size_t i) {
-    const SurfacePiece& p = pieces[refs[i].piece];
-    out.sticks[i] = refs[i].key;
-    out.t[i] = p.t[refs[i].index];
-    out.velocity[i] = p.velocity.empty() ? 0 : p.velocity[refs[i].index];
-  });
-  for (size_t i = 1; i < out.sticks.size(); ++i)
-    if (out.sticks[i] == out.sticks[i - 1]) throw std::logic_error("press_state: a stick is owned by two pieces");
+  out.pieces.reserve(pieces.size());
+  for (const SurfacePiece& p : pieces) out.pieces.push_back({p.block, p.sticks, p.t, p.velocity});
   return out;
 }
 
-SurfacePiece press_block_round(const BinaryVolume& samples, const ChunkGrid& grid, size_t b,
-                               const SurfaceOptions& options, const PressRound& round, const PressState& state) {
-  BlockPress bp(samples, grid, b, state);
-  const PressOptions po = block_press_options(options);
-  detail::SweepWindow window{round.first, round.last, &bp.velocity, &bp.owned, {}};
+// The block's sticks placed for pressing, once: on their own box (as the
+// whole run), with the layout's order and families.
+struct BlockRounds::Impl {
+  detail::BlockSticks bs;
+  OwnBox frame;
+  SliceCurves curves;  // the layout's families point into it
+  detail::Layout layout;
+  std::vector<uint8_t> owned;  // layout order
+  std::vector<uint32_t> owner;  // stick order: the block that owns it
+  PressOptions po;
+  SurfaceOptions options;
+  const ChunkGrid grid;
+  size_t b;
+  Impl(const BinaryVolume& samples, const ChunkGrid& g, size_t block, const SurfaceOptions& o)
+      : bs(detail::block_sticks(samples, g, block, ExtractOptions{})),
+        po(block_press_options(o)),
+        options(o),
+        grid(g),
+        b(block) {
+    bs.s = on_own_box(std::move(bs.s), &frame);
+    curves = build_slice_curves(bs.s);
+    detail::make_layout(bs.s, curves, layout);
+    owned.resize(bs.s.stick_count());
+    for (size_t i = 0; i < owned.size(); ++i) owned[i] = bs.owned[layout.old_of[i]];
+    // Each stick's owner: the block holding its lower sample (the key's padded one, less one).
+    owner.resize(bs.s.stick_count());
+    const uint64_t px = uint64_t(grid.dims[0] + 2), py = uint64_t(grid.dims[1] + 2);
+    for (size_t id = 0; id < owner.size(); ++id) {
+      const uint64_t key = bs.key[id], row = key / px / 3;
+      owner[id] = uint32_t(grid.block_of({int64_t(key % px) - 1, int64_t(row % py) - 1, int64_t(row / py) - 1}));
+    }
+  }
+  // t and momentum in layout order from `state` (sticks it does not hold,
+  // the block's artificial border: the extraction's t, at rest). Each stick
+  // is looked up in its owner's piece; a block's sticks are in whole-run key
+  // order (the canonical order of a sub-box), as are a piece's, so the
+  // search in each piece only moves forwards.
+  void load(const PressState& state, std::vector<double>& t, std::vector<double>& velocity) const {
+    const size_t n = bs.s.stick_count();
+    std::vector<int32_t> slot(grid.count(), -1);
+    for (size_t k = 0; k < state.pieces.size(); ++k) {
+      const PressState::Piece& p = state.pieces[k];
+      if (p.block >= slot.size() || slot[p.block] >= 0 || p.t.size() != p.sticks.size() ||
+          (!p.velocity.empty() && p.velocity.size() != p.sticks.size()))
+        throw UsageError("a round's state: a piece is repeated, not of this grid, or its arrays do not match");
+      slot[p.block] = int32_t(k);
+    }
+    std::vector<size_t> from(state.pieces.size(), 0);
+    t.resize(n);
+    velocity.assign(n, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t old = layout.old_of[i];
+      t[i] = bs.s.t[old];
+    }
+    for (size_t id = 0; id < n; ++id) {
+      const int32_t k = slot[owner[id]];
+      if (k < 0) continue;
+      const PressState::Piece& p = state.pieces[size_t(k)];
+      if (from[size_t(k)] < p.sticks.size() && p.sticks[from[size_t(k)]] > bs.key[id]) from[size_t(k)] = 0;  // not in order: search it all
+      const auto at = std::lower_bound(p.sticks.begin() + ptrdiff_t(from[size_t(k)]), p.sticks.end(), bs.key[id]);
+      if (at == p.sticks.end() || *at != bs.key[id]) continue;
+      const size_t j = size_t(at - p.sticks.begin());
+      from[size_t(k)] = j;
+      t[layout.new_of[id]] = p.t[j];
+      if (!p.velocity.empty()) velocity[layout.new_of[id]] = p.velocity[j];
+    }
+  }
+};
+
+BlockRounds::BlockRounds(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options)
+    : impl_(std::make_unique<Impl>(samples, grid, b, options)) {}
+BlockRounds::~BlockRounds() = default;
+BlockRounds::BlockRounds(BlockRounds&&) noexcept = default;
+
+uint64_t BlockRounds::bytes() const {
+  const Impl& m = *impl_;
+  const size_t n = m.bs.s.stick_count();
+  uint64_t out = n * (sizeof(uint64_t) * 2 + 2 + sizeof(double) + 4 * 4 + 2 * sizeof(uint32_t)) +
+                 m.bs.s.triangles.size() * sizeof(Triangle);
+  for (int a = 0; a < 3; ++a) out += (m.curves.ids[a].size() + m.curves.offsets[a].size() + m.layout.ids[a].size()) * 4;
+  out += m.layout.families.size() * sizeof(detail::Family);
+  return out;
+}
+
+SurfacePiece BlockRounds::round(const PressRound& round, const PressState& state) const {
+  const Impl& m = *impl_;
+  std::vector<double> t, velocity;
+  m.load(state, t, velocity);
+  detail::SweepWindow window{round.first, round.last, &velocity, &m.owned, {}};
   PressStats st;
-  if (!bp.t.empty())
-    st = detail::iterate(bp.t, bp.layout.families, 2, {}, {}, po, press_levels_for_extent(po.levels, bp.layout.extent),
+  if (!t.empty())
+    st = detail::iterate(t, m.layout.families, 2, {}, {}, m.po, press_levels_for_extent(m.po.levels, m.layout.extent),
                          &window);
-  bp.put_back();
-  SurfacePiece out = detail::owned_piece(bp.bs, grid, b, false);
-  // The owned sticks' momentum, in the piece's order (stick order).
-  std::vector<double> by_stick(bp.t.size());
-  for (size_t i = 0; i < bp.t.size(); ++i) by_stick[bp.layout.old_of[i]] = bp.velocity.empty() ? 0 : bp.velocity[i];
-  for (size_t id = 0; id < by_stick.size(); ++id)
-    if (bp.bs.owned[id]) out.velocity.push_back(by_stick[id]);
+  // The owned sticks' t and momentum, in the piece's order (stick order).
+  SurfacePiece out;
+  out.block = m.b;
+  out.blocks = m.grid.count();
+  std::vector<double> t_of(t.size()), v_of(t.size());
+  for (size_t i = 0; i < t.size(); ++i) {
+    t_of[m.layout.old_of[i]] = t[i];
+    v_of[m.layout.old_of[i]] = velocity.empty() ? 0 : velocity[i];
+  }
+  for (size_t id = 0; id < t_of.size(); ++id)
+    if (m.bs.owned[id]) {
+      out.sticks.push_back(m.bs.key[id]);
+      out.code.push_back(m.bs.s.code[id]);
+      out.t.push_back(t_of[id]);
+      out.velocity.push_back(v_of[id]);
+    }
   out.residuals = std::move(window.residuals);
   if (out.residuals.empty()) out.residuals.assign(size_t(std::max(round.last - round.first, 0)), std::nan(""));
   out.press = st;
   return out;
 }
 
-SurfacePiece finish_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options,
-                          const PressState& state, bool measure) {
-  BlockPress bp(samples, grid, b, state);
-  const PressOptions po = block_press_options(options);
+SurfacePiece BlockRounds::finish(const PressState& state, bool measure) const {
+  const Impl& m = *impl_;
+  std::vector<double> t, velocity;
+  m.load(state, t, velocity);
   double residual = 0;
-  if (measure && !bp.t.empty()) residual = detail::residual_at(bp.t, bp.layout.families, 2, po, &bp.owned);
-  bp.put_back([&](StickSurface& s) {
-    if (!options.passes.on(Pass::quadric_fit) || s.stick_count() == 0) return;
-    // The whole run's fit without flats (smooth/pipeline.cpp): no region, no junction.
-    QuadricFitOptions fo = options.fit;
-    fo.margin = po.margin;
-    fit_local_quadrics(s, std::vector<int32_t>(s.stick_count(), -1), {}, fo);
-  });
-  SurfacePiece out = detail::owned_piece(bp.bs, grid, b, true);
+  if (measure && !t.empty()) residual = detail::residual_at(t, m.layout.families, 2, m.po, &m.owned);
+  detail::BlockSticks bs = m.bs;  // the fit moves them: the last step's own copy
+  for (size_t i = 0; i < t.size(); ++i) bs.s.t[m.layout.old_of[i]] = t[i];
+  if (m.options.passes.on(Pass::quadric_fit) && bs.s.stick_count() > 0) {
+    // The whole run's fit without flats (smooth/pipeline.cpp): no region, no
+    // junction; only the owned sticks move (their piece), so only the sites
+    // they read are fitted.
+    QuadricFitOptions fo = m.options.fit;
+    fo.margin = m.po.margin;
+    fit_local_quadrics(bs.s, std::vector<int32_t>(bs.s.stick_count(), -1), {}, fo, &m.bs.owned);
+  }
+  bs.s = off_own_box(std::move(bs.s), m.frame);
+  SurfacePiece out = detail::owned_piece(bs, m.grid, m.b, true);
   if (measure) out.residuals.assign(1, residual);
   return out;
 }

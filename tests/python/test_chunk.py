@@ -166,3 +166,32 @@ def test_dask_press_labels_takes_all_as_press_labels_does():
         np.testing.assert_array_equal(every[label].faces, mesh.faces)
     with pytest.raises(voxpress.UsageError, match="labels="):
         voxpress.dask.press_labels(vol, labels="7,300", chunk=8)
+
+
+def test_a_held_block_is_the_same_after_any_round_and_through_pickle():
+    """voxpress.dask keeps a block extracted between its rounds (_BlockRounds):
+    a round changes nothing it holds, and a worker that receives it pickled
+    extracts it again to the same rounds."""
+    import pickle
+
+    mask = sphere(48)
+    shape, chunk, halo = mask.shape, 24, 12
+    inside = np.argwhere(mask)
+    bounds = (inside.min(axis=0).tolist(), (inside.max(axis=0) + 1).tolist())
+    rounds = voxpress._voxpress._press_rounds(shape, halo=halo, bounds=bounds)
+    assert len(rounds) > 2 and rounds[-1][2] and not rounds[0][2]  # only the last stage's rounds are measured
+    plan = voxpress.chunk_plan(shape, chunk=chunk, halo=halo)
+    (x0, y0, z0), (x1, y1, z1) = plan[0]["read"]
+    args = dict(shape=shape, block=0, chunk=chunk, halo=halo, bounds=bounds, threads=1)
+    held = voxpress._voxpress._BlockRounds(mask[x0:x1, y0:y1, z0:z1], args)
+    first = held.round([], rounds[0][0], rounds[0][1])
+    later = held.round([first], rounds[1][0], rounds[1][1])
+    again = pickle.loads(pickle.dumps(held))
+    assert held.nbytes > 0
+    for a, b in [(first, held.round([], rounds[0][0], rounds[0][1])), (first, again.round([], rounds[0][0], rounds[0][1])),
+                 (later, again.round([first], rounds[1][0], rounds[1][1]))]:
+        for key in ("sticks", "t", "velocity"):
+            np.testing.assert_array_equal(a[key], b[key])
+    assert not np.array_equal(first["t"], later["t"])
+    with pytest.raises(voxpress.UsageError, match="repeated"):
+        held.round([first, first], rounds[1][0], rounds[1][1])

@@ -29,9 +29,11 @@
 // own sticks see only true neighbours, then the blocks exchange the t and
 // momentum of their sticks (PressState) and the next round starts from
 // them: the whole run's sweeps exactly, up to rounding (positions are taken
-// relative to each block's own box). A last step (finish_block) runs the
-// quadric fit on the final t, whose reach (a dozen rings) the halo must
-// also cover. Flats are off in that mode (a plane across blocks would need
+// relative to each block's own box). Each block is read and extracted once
+// (BlockRounds: a Dask worker keeps it between the block's rounds; in
+// process every block's is kept, about the surface again with its halos). A
+// last step (BlockRounds::finish) runs the quadric fit on the final t,
+// whose reach (a dozen rings) the halo must also cover. Flats are off in that mode (a plane across blocks would need
 // one vote over all of them); levels come from the whole volume's extent,
 // so blocks press with the whole run's stages.
 #pragma once
@@ -39,6 +41,8 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "voxpress/core/mesh.h"
@@ -71,6 +75,8 @@ struct ChunkGrid {
   size_t count() const { return size_t(n_[0] * n_[1] * n_[2]); }
   Box core(size_t b) const;       ///< the samples block b owns
   Box with_halo(size_t b) const;  ///< core grown by max(halo, 1), clipped to the volume
+  /// The block whose core holds `sample` clamped into the volume (a stick's owner: its lower sample's).
+  size_t block_of(const std::array<int64_t, 3>& sample) const;
 
  private:
   std::array<int64_t, 3> n_{};  // blocks per axis
@@ -93,7 +99,7 @@ struct SurfacePiece {
   std::vector<uint64_t> triangles;  ///< owned triangles: 3 stick keys each, in whole-run order
   std::vector<double> velocity;     ///< a round's piece: the momentum of each owned stick
   /// A round's piece: per sweep of the round, the residual over the owned
-  /// sticks (NaN before the last stage); finish_block's: one, at the final t.
+  /// sticks (NaN before the last stage); BlockRounds::finish's: one, at the final t.
   std::vector<double> residuals;
   PressStats press;                 ///< the block's Pressing (iterations == 0: nothing to press)
   uint64_t block = 0, blocks = 0;   ///< which block of how many (stitch wants each exactly once)
@@ -109,6 +115,7 @@ SurfacePiece press_block(const BinaryVolume& samples, const ChunkGrid& grid, siz
 /// Sweeps [first, last) of the whole run's schedule (PressOptions::iterations).
 struct PressRound {
   int first = 0, last = 0;
+  bool measured = false;  ///< holds sweeps of the last stage (whose residuals may stop the run)
 };
 /// The halo mode's rounds for `options` (as chunk_surface_options returns
 /// them: levels set): each as many sweeps as keep every owned stick beyond
@@ -117,26 +124,48 @@ struct PressRound {
 /// names the smallest halo).
 std::vector<PressRound> press_rounds(const Lattice& lattice, const SurfaceOptions& options, int64_t halo);
 
-/// Every owned stick's t and momentum between rounds, by key (increasing).
+/// Where a round starts: the last round's pieces (each block's at most
+/// once: all of them, or those of the blocks around the one reading them),
+/// viewed where they are. A block finds each of its sticks in its owner's
+/// piece (a round's piece holds its owned sticks by increasing key).
 struct PressState {
-  std::vector<uint64_t> sticks;
-  std::vector<double> t, velocity;
+  struct Piece {
+    uint64_t block = 0;
+    std::span<const uint64_t> sticks;
+    std::span<const double> t, velocity;  ///< velocity may be empty (at rest)
+  };
+  std::vector<Piece> pieces;
 };
-/// The rounds' pieces (each block once, any order) as one state; with a
-/// grid, only the sticks block b reads (its box with the halo: what a Dask
-/// task needs of its neighbours' pieces).
-PressState press_state(const std::vector<SurfacePiece>& pieces, const ChunkGrid* grid = nullptr, size_t b = 0);
+/// Views of the pieces (which must outlive the state).
+PressState press_state(const std::vector<SurfacePiece>& pieces);
 
-/// Block b's round: its sticks (owned or in its halo) start from `state`
-/// (empty: the extraction's t, at rest), the round's sweeps run, and the
-/// piece holds the owned sticks' t, momentum and residuals (no triangles).
-SurfacePiece press_block_round(const BinaryVolume& samples, const ChunkGrid& grid, size_t b,
-                               const SurfaceOptions& options, const PressRound& round, const PressState& state);
-/// Block b's last step: its sticks at `state`'s t (after the last round),
-/// the residual there (`residuals`, one value, when `measure`), then the
-/// quadric fit; the piece holds the owned sticks and triangles, for stitch.
-SurfacePiece finish_block(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options,
-                          const PressState& state, bool measure);
+/// Block b in the halo mode: its sticks extracted from `samples` (its read
+/// box) once, placed on their own box with the layout the sweeps run on,
+/// so that every round and the last step reuse them (a Dask worker keeps
+/// one between a block's rounds). Each call starts from a state and changes
+/// nothing it holds: any round in any order gives what a fresh extraction
+/// would.
+class BlockRounds {
+ public:
+  BlockRounds(const BinaryVolume& samples, const ChunkGrid& grid, size_t b, const SurfaceOptions& options);
+  ~BlockRounds();
+  BlockRounds(BlockRounds&&) noexcept;
+  /// The round's sweeps: the block's sticks (owned or in its halo) start
+  /// from `state` (those it lacks, and every stick when it is empty: the
+  /// extraction's t, at rest); the piece holds the owned sticks' t,
+  /// momentum and residuals (no triangles).
+  SurfacePiece round(const PressRound& round, const PressState& state) const;
+  /// The last step: the sticks at `state`'s t (after the last round), the
+  /// residual there (`residuals`, one value, when `measure`), then the
+  /// quadric fit; the piece holds the owned sticks and triangles, for stitch.
+  SurfacePiece finish(const PressState& state, bool measure) const;
+  /// Memory held (what a Dask worker reports for it).
+  uint64_t bytes() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// One piece of consecutive pieces (each piece's blocks follow the one
 /// before): sticks and triangles merged in whole-run order (k-way), so a
