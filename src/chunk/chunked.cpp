@@ -373,8 +373,13 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
   st.levels = so.press.levels;
   PressOptions po = so.press;  // the tolerance as the blocks run it (the overrides applied)
   so.overrides.apply(po);
-  // Each block read and extracted once (as a Dask worker keeps it).
+  // Each block read and extracted once (as a Dask worker keeps it), while
+  // the kept blocks fit in half the memory cap (the rest: the stitched
+  // surface); a block beyond it is read and extracted again every round.
+  // The same bytes either way.
   std::vector<std::optional<BlockRounds>> blocks(nb);
+  const uint64_t budget = so.extract.max_bytes ? so.extract.max_bytes / 2 : UINT64_MAX;
+  std::atomic<uint64_t> kept{0};
   const auto each_block = [&](auto&& f) {
     detail::parallel_ranges(nb, 1, [&](detail::IndexRange range) {
       for (size_t b = range.begin(); b < range.end(); ++b) {
@@ -383,9 +388,20 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
       }
     });
   };
-  each_block([&](size_t b) { blocks[b].emplace(block_of(b), grid, b, so); });
+  each_block([&](size_t b) {
+    BlockRounds block(block_of(b), grid, b, so);
+    const uint64_t bytes = block.bytes();
+    if (kept.fetch_add(bytes) + bytes <= budget)
+      blocks[b].emplace(std::move(block));
+    else
+      kept.fetch_sub(bytes);
+  });
+  const auto with_block = [&](size_t b, auto&& f) {
+    if (blocks[b]) return f(*blocks[b]);
+    return f(BlockRounds(block_of(b), grid, b, so));  // not kept: read for this call
+  };
   const auto run_round = [&](const PressRound& r, const PressState& state) {
-    each_block([&](size_t b) { pieces[b] = blocks[b]->round(r, state); });
+    each_block([&](size_t b) { pieces[b] = with_block(b, [&](const BlockRounds& k) { return k.round(r, state); }); });
   };
   std::vector<SurfacePiece> last(nb);  // the pieces the state views (pieces: the round's, swapped)
   PressState state;
@@ -420,7 +436,7 @@ PressStats press_in_rounds(const Lattice& lattice, const ChunkGrid& grid, const 
     }
     if (stopped) break;
   }
-  each_block([&](size_t b) { pieces[b] = blocks[b]->finish(state, !stopped); });
+  each_block([&](size_t b) { pieces[b] = with_block(b, [&](const BlockRounds& k) { return k.finish(state, !stopped); }); });
   if (!stopped) {  // the cap ended it: the residual at the final t
     double res = 0;
     for (const SurfacePiece& p : pieces)
