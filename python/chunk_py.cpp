@@ -1,9 +1,10 @@
 // The chunked core for Python: chunk_plan (the blocks and the boxes to read),
 // _press_block (one block's piece: numpy arrays of global stick keys, so a
 // piece pickles compactly for Dask), _merge (consecutive pieces -> one:
-// the tree reduction's step), _stitch (pieces -> Mesh), and the
-// in-process press(..., chunk=) path. voxpress/dask.py maps _press_block
-// over a Dask array's blocks; the results are the CLI's `press --chunk`.
+// the tree reduction's step), _stitch (pieces -> Mesh), _BlockRounds and
+// _press_rounds (the halo mode's blocks and rounds), and the in-process
+// press(..., chunk=) path. voxpress/dask.py maps them over a Dask array's
+// blocks; the results are the CLI's `press --chunk`.
 #include <pybind11/stl.h>
 #include <tbb/task_arena.h>
 

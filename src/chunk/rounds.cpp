@@ -1,7 +1,5 @@
 // Blocks pressed apart in exchange rounds: the whole run's sweeps, block by
 // block. Theory of operation: include/voxpress/chunk/chunked.h.
-#include <tbb/parallel_sort.h>
-
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -10,7 +8,6 @@
 #include <numbers>
 
 #include "chunk/block.h"
-#include "core/parallel.h"
 #include "smooth/curve_kernel.h"
 #include "voxpress/core/error.h"
 
@@ -130,10 +127,7 @@ struct BlockRounds::Impl {
     std::vector<size_t> from(state.pieces.size(), 0);
     t.resize(n);
     velocity.assign(n, 0.0);
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t old = layout.old_of[i];
-      t[i] = bs.s.t[old];
-    }
+    for (size_t i = 0; i < n; ++i) t[i] = bs.s.t[layout.old_of[i]];
     for (size_t id = 0; id < n; ++id) {
       const int32_t k = slot[owner[id]];
       if (k < 0) continue;
