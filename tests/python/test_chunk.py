@@ -84,6 +84,13 @@ def test_dask_on_a_local_cluster_gives_the_in_process_bytes():
         array = da.from_array(mask.astype(np.uint8), chunks=96)  # Dask's chunks need not be the blocks
         # split_every=3: the 8 pieces merge on the workers (3 + 3 + 2), then the caller stitches 3.
         mesh = voxpress.dask.press(array, chunk=128, spacing=spacing, origin=origin, client=client, split_every=3)
+        # Blocks pressed on the workers (a halo): each block held on a worker
+        # between its rounds, the pieces moving between the processes.
+        part = mask[100:164, 100:164, 20:84]
+        held = voxpress.dask.press(da.from_array(part, chunks=32), chunk=32, halo=12, client=client)
+    apart = voxpress.press(part, chunk=32, halo=12)
+    np.testing.assert_array_equal(held.vertices, apart.vertices)
+    np.testing.assert_array_equal(held.faces, apart.faces)
     np.testing.assert_array_equal(mesh.faces, ref.faces)
     np.testing.assert_array_equal(mesh.vertices, ref.vertices)
     assert mesh.stats["blocks"] == 8
