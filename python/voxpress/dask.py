@@ -152,7 +152,8 @@ def press(array, *, chunk=256, halo=0, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0
     sharp edges included; the caller holds the surface, never the volume.
     halo=H: the workers press their blocks too, reading H samples around
     them, in rounds that exchange the blocks' borders (`press --chunk N
-    --halo H`): no process holds more than a block's surface; Pressing only
+    --halo H`): each worker holds its blocks' surfaces (with their halos),
+    the caller only the stitched mesh; Pressing only
     (flats off); the whole run's surface up to rounding (stats iterations
     and residual as press()'s); the wider the halo, the fewer the rounds
     (docs/BENCHMARKS.md, Chunked). client: a dask.distributed Client; None
