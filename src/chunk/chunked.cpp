@@ -19,6 +19,7 @@
 
 namespace voxpress {
 
+using detail::KeyCodec;
 using detail::seconds_since;
 
 namespace {
@@ -33,16 +34,6 @@ bool in_core(const Box& core, const std::array<int64_t, 3>& dims, const std::arr
   }
   return true;
 }
-
-struct KeyCodec {
-  uint64_t px, py;
-  explicit KeyCodec(const std::array<int64_t, 3>& dims) : px(uint64_t(dims[0] + 2)), py(uint64_t(dims[1] + 2)) {}
-  // padded (p, q, r) and axis of a key
-  std::array<uint64_t, 4> decode(uint64_t key) const {
-    const uint64_t p = key % px, rest = key / px, a = rest % 3, row = rest / 3;
-    return {p, row % py, row / py, a};
-  }
-};
 
 }  // namespace
 
@@ -166,16 +157,18 @@ detail::BlockSticks detail::block_sticks(const BinaryVolume& block, const ChunkG
   return out;
 }
 
-SurfacePiece detail::owned_piece(const BlockSticks& bs, const ChunkGrid& grid, size_t b, bool triangles) {
+SurfacePiece detail::owned_piece(const BlockSticks& bs, const ChunkGrid& grid, size_t b, bool triangles,
+                                 const std::vector<double>* t) {
   SurfacePiece out;
   out.block = b;
   out.blocks = grid.count();
   const StickSurface& s = bs.s;
+  const std::vector<double>& ts = t ? *t : s.t;
   for (size_t id = 0; id < s.stick_count(); ++id)
     if (bs.owned[id]) {
       out.sticks.push_back(bs.key[id]);
       out.code.push_back(s.code[id]);
-      out.t.push_back(s.t[id]);
+      out.t.push_back(ts[id]);
     }
   if (!triangles) return out;
   // A triangle's cube is the componentwise minimum of its three sticks' lower

@@ -101,13 +101,10 @@ struct BlockRounds::Impl {
     detail::make_layout(bs.s, curves, layout);
     owned.resize(bs.s.stick_count());
     for (size_t i = 0; i < owned.size(); ++i) owned[i] = bs.owned[layout.old_of[i]];
-    // Each stick's owner: the block holding its lower sample (the key's padded one, less one).
+    // Each stick's owner: the block holding its lower sample.
+    const detail::KeyCodec codec(grid.dims);
     owner.resize(bs.s.stick_count());
-    const uint64_t px = uint64_t(grid.dims[0] + 2), py = uint64_t(grid.dims[1] + 2);
-    for (size_t id = 0; id < owner.size(); ++id) {
-      const uint64_t key = bs.key[id], row = key / px / 3;
-      owner[id] = uint32_t(grid.block_of({int64_t(key % px) - 1, int64_t(row % py) - 1, int64_t(row / py) - 1}));
-    }
+    for (size_t id = 0; id < owner.size(); ++id) owner[id] = uint32_t(grid.block_of(codec.lower(bs.key[id])));
   }
   // t and momentum in layout order from `state` (sticks it does not hold,
   // the block's artificial border: the extraction's t, at rest). Each stick
@@ -150,11 +147,11 @@ BlockRounds::BlockRounds(BlockRounds&&) noexcept = default;
 
 uint64_t BlockRounds::bytes() const {
   const Impl& m = *impl_;
-  const size_t n = m.bs.s.stick_count();
-  uint64_t out = n * (sizeof(uint64_t) * 2 + 2 + sizeof(double) + 4 * 4 + 2 * sizeof(uint32_t)) +
-                 m.bs.s.triangles.size() * sizeof(Triangle);
-  for (int a = 0; a < 3; ++a) out += (m.curves.ids[a].size() + m.curves.offsets[a].size() + m.layout.ids[a].size()) * 4;
-  out += m.layout.families.size() * sizeof(detail::Family);
+  const auto of = [](const auto& v) { return uint64_t(v.size() * sizeof(v[0])); };
+  uint64_t out = of(m.bs.s.lower) + of(m.bs.s.code) + of(m.bs.s.t) + of(m.bs.s.triangles) + of(m.bs.key) +
+                 of(m.bs.owned) + of(m.owned) + of(m.owner) + of(m.layout.old_of) + of(m.layout.new_of);
+  for (int a = 0; a < 3; ++a) out += of(m.curves.ids[a]) + of(m.curves.offsets[a]) + of(m.layout.ids[a]);
+  for (const detail::Family& f : m.layout.families) out += sizeof(f) + of(f.base) + of(f.mov) + of(f.dst) + of(f.spans);
   return out;
 }
 
@@ -168,21 +165,14 @@ SurfacePiece BlockRounds::round(const PressRound& round, const PressState& state
     st = detail::iterate(t, m.layout.families, 2, {}, {}, m.po, press_levels_for_extent(m.po.levels, m.layout.extent),
                          &window);
   // The owned sticks' t and momentum, in the piece's order (stick order).
-  SurfacePiece out;
-  out.block = m.b;
-  out.blocks = m.grid.count();
   std::vector<double> t_of(t.size()), v_of(t.size());
   for (size_t i = 0; i < t.size(); ++i) {
     t_of[m.layout.old_of[i]] = t[i];
     v_of[m.layout.old_of[i]] = velocity.empty() ? 0 : velocity[i];
   }
-  for (size_t id = 0; id < t_of.size(); ++id)
-    if (m.bs.owned[id]) {
-      out.sticks.push_back(m.bs.key[id]);
-      out.code.push_back(m.bs.s.code[id]);
-      out.t.push_back(t_of[id]);
-      out.velocity.push_back(v_of[id]);
-    }
+  SurfacePiece out = detail::owned_piece(m.bs, m.grid, m.b, false, &t_of);
+  for (size_t id = 0; id < v_of.size(); ++id)
+    if (m.bs.owned[id]) out.velocity.push_back(v_of[id]);
   out.residuals = std::move(window.residuals);
   if (out.residuals.empty()) out.residuals.assign(size_t(std::max(round.last - round.first, 0)), std::nan(""));
   out.press = st;

@@ -31,9 +31,10 @@
 // them: the whole run's sweeps exactly, up to rounding (positions are taken
 // relative to each block's own box). Each block is read and extracted once
 // (BlockRounds: a Dask worker keeps it between the block's rounds; in
-// process every block's is kept, about the surface again with its halos). A
-// last step (BlockRounds::finish) runs the quadric fit on the final t,
-// whose reach (a dozen rings) the halo must also cover. Flats are off in that mode (a plane across blocks would need
+// process, blocks are kept while they fit in half the memory cap, the rest
+// read again every round). A last step (BlockRounds::finish) runs the
+// quadric fit on the final t, whose reach (a dozen rings) the halo must
+// also cover. Flats are off in that mode (a plane across blocks would need
 // one vote over all of them); levels come from the whole volume's extent,
 // so blocks press with the whole run's stages.
 #pragma once
